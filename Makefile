@@ -10,7 +10,7 @@ DE := $(VENV)/bin/diffengine
 OUT := $(ROOT)/out
 DEMO_FILE ?= sw/scenes/fig7_25.cmd
 
-.PHONY: help setup demo test test-py test-long bench clean
+.PHONY: help setup demo test test-py test-c test-rtl test-long bench clean
 
 help:
 	@echo "make demo        render the shipped default command file to out/demo.png"
@@ -30,10 +30,17 @@ demo: $(SETUP)
 	$(ENV) $(DE) plot $(DEMO_FILE) -o $(OUT)/demo_scanlines.png
 	@echo "demo: wrote $(OUT)/demo.png and $(OUT)/demo_scanlines.png"
 
-test: test-py
+# make test = Python model tests + C host tests (if present) + RTL tests (if present).
+test: test-py test-c test-rtl
 
 test-py: $(SETUP)
 	$(ENV) cd sw && $(PY) -m pytest -q -n 2 tests
+
+test-c:
+	@if [ -f sw/hsr/Makefile ]; then $(MAKE) -C sw/hsr test; fi
+
+test-rtl: $(SETUP)
+	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 .; fi
 
 bench: $(SETUP)
 	$(ENV) $(PY) scripts/bench_model.py
