@@ -1,0 +1,107 @@
+#!/usr/bin/env python3
+"""Benchmark the functional golden model on random but realistic 640x480 frames.
+
+Two frames, ~100 commands per line, spans of 5-60 px at random X:
+  * "eval-only": Eval1/2/3 (20/40/40 %) - every line takes the batched frame path;
+  * "mixed": the same plus, per line, about 3 Set/SetP/Dis/Eval0 commands - every
+    line then takes the per-command path.
+Prints commands/s and seconds/frame (best of --repeat) and, with --write, updates the
+"Golden model (functional)" section of docs/performance.md (other sections untouched).
+"""
+from __future__ import annotations
+
+import argparse
+import platform
+import re
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "sw"))
+
+from diffengine import functional, isa  # noqa: E402
+
+ONE = 1 << isa.FRAC_BITS
+SECTION = "## Golden model (functional)"
+
+
+def random_frame(rng, width=640, height=480, per_line=100, mixed=False):
+    cmds = []
+    for _ in range(height):
+        for _ in range(per_line):
+            x = int(rng.integers(0, width))
+            dx = int(rng.integers(5, 61))
+            order = int(rng.choice([0, 1, 2], p=[0.2, 0.4, 0.4]))
+            vals = [int(rng.integers(0, 200 * ONE)), int(rng.integers(-ONE, ONE)),
+                    int(rng.integers(-ONE // 32, ONE // 32))][: order + 1]
+            cmds.append(isa.Command("EVAL", x, dx, tuple(vals)))
+        if mixed:
+            for _ in range(3):
+                x = int(rng.integers(0, width))
+                kind = rng.choice(["SETDDI", "SETI", "SETPDI", "DIS", "EVAL0"])
+                if kind == "DIS":
+                    cmd = isa.Command("DIS", x, int(rng.integers(1, 20)))
+                elif kind == "EVAL0":
+                    cmd = isa.Command("EVAL0", x, int(rng.integers(1, 20)), (int(rng.integers(0, 4096)),))
+                elif kind == "SETPDI":
+                    cmd = isa.Command("SETPDI", x, int(rng.integers(5, 40)), (int(rng.integers(-ONE, ONE)),))
+                else:
+                    cmd = isa.Command(str(kind), x, 1, (int(rng.integers(-ONE, ONE)),))
+                cmds.insert(len(cmds) - int(rng.integers(0, per_line)), cmd)
+        cmds.append(isa.Command("REFRESH"))
+    return cmds
+
+
+def bench(cmds, repeat):
+    best = float("inf")
+    for _ in range(repeat):
+        t = time.perf_counter()
+        functional.render(cmds)
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--write", action="store_true", help="update docs/performance.md")
+    args = ap.parse_args(argv)
+    rows = []
+    for name, mixed in (("eval-only", False), ("mixed", True)):
+        cmds = random_frame(np.random.default_rng(args.seed), mixed=mixed)
+        sec = bench(cmds, args.repeat)
+        rows.append((name, len(cmds), sec, len(cmds) / sec))
+        print(f"{name:10s} {len(cmds):7d} commands  {sec:7.3f} s/frame  {len(cmds) / sec:12,.0f} commands/s")
+    if args.write:
+        write_doc(rows)
+
+
+def write_doc(rows):
+    path = ROOT / "docs" / "performance.md"
+    text = path.read_text() if path.exists() else "# Performance\n"
+    table = "\n".join(f"| {n} | {c} | {s:.3f} | {r:,.0f} |" for n, c, s, r in rows)
+    body = f"""{SECTION}
+
+`functional.render()` on a random 640x480 frame, ~100 commands per line (Eval1/2/3 spans
+of 5-60 px; "mixed" adds ~3 Set/SetP/Dis/Eval0 per line, which sends every line through
+the per-command path instead of the batched Eval1-3 frame path). Best of 3, one core,
+{platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}, {platform.machine()}.
+
+| frame | commands | s/frame | commands/s |
+|---|---|---|---|
+{table}
+
+Reproduce: `.venv/bin/python scripts/bench_model.py --write`
+"""
+    pat = re.compile(re.escape(SECTION) + r".*?(?=^## |\Z)", re.S | re.M)
+    text = pat.sub(body + "\n", text) if pat.search(text) else text.rstrip("\n") + "\n\n" + body
+    path.write_text(text)
+    print(f"updated {path}")
+
+
+if __name__ == "__main__":
+    main()
