@@ -1,0 +1,52 @@
+"""Shared cocotb runner glue: one build folder per parameter set, paths independent
+of the current directory, seeds printed so a random run can be replayed."""
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from cocotb_tools.runner import get_runner
+
+REPO = Path(__file__).resolve().parents[2]
+RTL = REPO / "rtl"
+
+
+def build_and_test(tb_dir: Path, toplevel: str, sources: list[Path], test_module: str,
+                   parameters: dict | None = None, extra_env: dict | None = None,
+                   testcase: str | None = None, waves: bool = False) -> None:
+    """Build `toplevel` from `sources` (cached per parameter set) and run `test_module`."""
+    parameters = parameters or {}
+    tag = "_".join(f"{k}{v}" for k, v in sorted(parameters.items())) or "default"
+    build_dir = tb_dir / f"sim_build_{tag}"
+    runner = get_runner("verilator")
+    runner.build(
+        sources=[str(s) for s in sources],
+        hdl_toplevel=toplevel,
+        parameters=parameters,
+        build_dir=build_dir,
+        build_args=["-Wno-fatal", "-MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include"]
+        + (["--trace-fst", "--trace-structs"] if waves else []),
+        waves=waves,
+    )
+    env = dict(extra_env or {})
+    env.setdefault("PYTHONPATH", os.pathsep.join([str(tb_dir), str(REPO / "tb"),
+                                                  str(REPO / "sw")]))
+    runner.test(
+        test_module=test_module,
+        hdl_toplevel=toplevel,
+        build_dir=build_dir,
+        test_dir=tb_dir,
+        extra_env=env,
+        testcase=testcase,
+        waves=waves,
+        results_xml=str(build_dir / "results.xml"),
+    )
+
+
+def seed_from_env(default: int | None = None) -> int:
+    """The random seed: SEED from the environment, else a fresh one; always printed."""
+    seed = int(os.environ.get("SEED", default if default is not None
+                              else int.from_bytes(os.urandom(4), "little")))
+    print(f"SEED={seed}  (re-run with SEED={seed})", file=sys.stderr)
+    return seed
