@@ -85,6 +85,9 @@ def _parse_number(tok: str, name: str, shift: int) -> tuple[Fraction, bool]:
                          "digits, no sign: it is the raw two's complement pattern)")
     if not _DEC.match(tok):
         raise ValueError(f"{name}: not a number: {tok!r}")
+    exp = tok.lower().partition("e")[2]
+    if exp and abs(int(exp)) > 99:  # keep Fraction from building 10**huge
+        raise ValueError(f"{name}: exponent of {tok!r} outside -99..99")
     return Fraction(tok) * (1 << shift), False
 
 

@@ -131,6 +131,8 @@ BAD = [
     ("Eval0 (0, 1, 0x001.800000);", "fraction"),
     ("Eval1 (55, 16, 0.9375.0);", "not a number"),       # the source's own typo
     ("Eval1 (55, 16, abc);", "not a number"),
+    ("Eval1 (55, 16, 1e999999999);", "exponent"),
+    ("Eval1 (55, 16, 1e-999999999);", "exponent"),
     ("Eval1 (55, 16, 0x01.800000);", "hex literal"),
     ("Eval1 (55, 16, -0x001.800000);", "hex literal"),
     ("Eval1 (55, 16, 0x10);", "hex literal"),
