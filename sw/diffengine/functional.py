@@ -140,7 +140,7 @@ class _Line:
             a, e = self.span(c.x, c.dx)
             self.set(isa.SET_REG[op], slice(a, e), c.values[0])
         elif op in ("SETPI", "SETPDI", "SETPDDI"):
-            step = c.dx if c.dx else MAX_COLS
+            step = c.dx if c.dx else 4096  # countdown reloads with dX-1 mod 4096
             self.set(isa.SET_REG[op], slice(min(c.x, self.s.width), None, step), c.values[0])
         elif op == "DIS":
             a, e = self.span(c.x, c.dx)
