@@ -119,11 +119,20 @@ def pixel_of(word: int) -> int:
     return (word >> FRAC_BITS) & BLOCK_MASK
 
 
-def compensate(value: int) -> int:
-    """§7.7 carry-bug compensation of a signed 36-bit value (returns a signed value)."""
+def compensate(value: int, literal: bool = False) -> int:
+    """§7.7 carry-bug compensation of a signed 36-bit value (returns a signed value).
+
+    The 24 fraction bits are shifted down one place, so that a fraction overflow (now
+    worth 0.5) that the faulty adder lands at bit 25 (+2) is worth exactly 1.0 again.
+    literal=True also sets bit 23 of negative values, as the source's text says; under
+    the modelled fault that makes a negative operand represent v + 1, so it is kept only
+    to reproduce and document that discrepancy (docs/isa.md §7).
+    """
     word = to_word(value)
     frac = word & 0xFFFFFF
-    out = (word & ~0xFFFFFF & WORD_MASK) | (frac >> 1) | (0x800000 if value < 0 else 0)
+    out = (word & ~0xFFFFFF & WORD_MASK) | (frac >> 1)
+    if literal and value < 0:
+        out |= 0x800000
     return to_signed(out)
 
 

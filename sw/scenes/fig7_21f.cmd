@@ -6,9 +6,9 @@
 # (a), (c), (e): the commands are identical; compensation is applied by the frame-store
 # data mapper (asm -f framestore --compensate, or model/plot --compensate):
 #   diffengine model fig7_21f.cmd -o out.png --carry-bug --compensate --window 0
-# Caveat: isa.compensate sets bit 23 for negative values, as the source's text says; in
-# this model that turns the falling dI = -0.0078125 of the first Eval2 into a rising one
-# (see docs/formats.md, "Carry-bug compensation").
+# Compensation halves the fraction only; the source's extra "set bit 23 when negative"
+# would turn the falling dI = -0.0078125 below into a rising ramp under the fault
+# (docs/isa.md §7, docs/formats.md "Carry-bug compensation").
 .unit dac 0
 Eval2 (1, 17, 0.5, -0.0078125);
 Eval3 (21, 33, 0.984375, 0.0, -0.001953125);

@@ -177,8 +177,8 @@ def test_mapper_compensation_matches_isa(w, idx, op):
 def test_mapper_compensation_table_7_5_values():
     # dI = 0.5 pixel at window 0: operand 0.5 * 2^20 -> data 0x000.800000 -> comp 0x000.400000
     assert map_word(10 << 27 | 1 << 19, 0, True) == (isa.D_B, 0x000400000)
-    # negative: -0.5 -> 0xfff.800000 -> comp sets bit 23 (§7)
-    assert map_word(10 << 27 | ((-(1 << 19)) & 0x7FFFFFF), 0, True) == (isa.D_B, 0xFFFC00000)
+    # negative: -0.5 -> 0xfff.800000 -> fraction halved, no sign fill (isa.md §7)
+    assert map_word(10 << 27 | ((-(1 << 19)) & 0x7FFFFFF), 0, True) == (isa.D_B, 0xFFF400000)
 
 
 def test_mapper_rejects_bad_arguments():
