@@ -49,11 +49,13 @@ module de_data_mapper (
     ident_d = valid_i ? ident : 12'h000;
     valid_d = valid_i;
     data_d  = 36'd0;
-    unique case (op_type)
-      2'd1:    data_d = {i12, 2'b00, operand[19:10], 2'b00, operand[9:0]};
-      2'd2:    data_d = compensate_i ? comp : int_wide;
-      default: data_d = 36'd0;
-    endcase
+    if (valid_i) begin
+      unique case (op_type)
+        2'd1:    data_d = {i12, 2'b00, operand[19:10], 2'b00, operand[9:0]};
+        2'd2:    data_d = compensate_i ? comp : int_wide;
+        default: data_d = 36'd0;
+      endcase
+    end
   end
 
   always_ff @(posedge clk_i) begin
