@@ -1,0 +1,435 @@
+/* hsr.c - exact incremental hidden-surface removal (sections 5.4.2 and
+ * 5.4.5).  MLR: the input domains, each with its lists of visibles and
+ * invisibles.  LLR: the visibility map, disjoint domains in a Grid-List,
+ * each with its parents ordered front to back up to the first opaque one
+ * (followed by the unordered hidden parents). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "internal.h"
+
+typedef struct ivec { int *v; int n, cap; } ivec;
+
+static int iv_push(ivec *a, int x)
+{
+    if (a->n == a->cap) {
+        int c = a->cap ? a->cap * 2 : 4;
+        int *q = realloc(a->v, sizeof(int) * (size_t)c);
+        if (!q) return 0;
+        a->v = q; a->cap = c;
+    }
+    a->v[a->n++] = x;
+    return 1;
+}
+static int iv_find(const ivec *a, int x) { for (int i = 0; i < a->n; i++) if (a->v[i] == x) return i; return -1; }
+static int iv_add(ivec *a, int x) { return iv_find(a, x) >= 0 || iv_push(a, x); }
+static void iv_del(ivec *a, int x)
+{
+    int i = iv_find(a, x);
+    if (i < 0) return;
+    memmove(a->v + i, a->v + i + 1, sizeof(int) * (size_t)(a->n - i - 1));
+    a->n--;
+}
+
+typedef struct mlr { int present; hsr_domain *dom; hsr_plane plane; double opacity; ivec vis, invis; } mlr;
+typedef struct llr { int used; hsr_domain *dom; ivec par; int nvis; } llr;
+
+struct hsr_ctx {
+    hsr_config cfg;
+    hsr_gridlist *grid;
+    mlr *m; int nm, capm;
+    llr *l; int nl, capl;
+    ivec freel;
+};
+
+#define OPAQUE(h, id) ((h)->m[id].opacity >= 1.0)
+
+hsr_status hsr_create(const hsr_config *cfg, hsr_ctx **out)
+{
+    if (!out) return HSR_EINVAL;
+    *out = NULL;
+    if (!cfg) return HSR_EINVAL;
+    hsr_ctx *h = calloc(1, sizeof *h);
+    if (!h) return HSR_ENOMEM;
+    h->cfg = *cfg;
+    hsr_status st = hsr_gridlist_create(cfg->window, cfg->grid_nx, cfg->grid_ny, &h->grid);
+    if (st != HSR_OK) { free(h); return st; }
+    *out = h;
+    return HSR_OK;
+}
+
+void hsr_destroy(hsr_ctx *h)
+{
+    if (!h) return;
+    for (int i = 0; i < h->nm; i++) {
+        hsr_domain_free(h->m[i].dom); free(h->m[i].vis.v); free(h->m[i].invis.v);
+    }
+    for (int i = 0; i < h->nl; i++) { hsr_domain_free(h->l[i].dom); free(h->l[i].par.v); }
+    free(h->m); free(h->l); free(h->freel.v);
+    hsr_gridlist_free(h->grid);
+    free(h);
+}
+
+/* ---- LLR slot management ------------------------------------------ */
+static hsr_status llr_create(hsr_ctx *h, hsr_domain *dom, const int *pre, int npre,
+                             const ivec *tail)
+{
+    int s;
+    if (h->freel.n) s = h->freel.v[--h->freel.n];
+    else {
+        if (h->nl == h->capl) {
+            int c = h->capl ? h->capl * 2 : 64;
+            llr *q = realloc(h->l, sizeof(llr) * (size_t)c);
+            if (!q) { hsr_domain_free(dom); return HSR_ENOMEM; }
+            h->l = q; h->capl = c;
+        }
+        s = h->nl++;
+        memset(&h->l[s], 0, sizeof(llr));
+    }
+    llr *L = &h->l[s];
+    L->used = 1; L->dom = dom; L->par.n = 0; L->nvis = npre;
+    int ok = 1;
+    for (int i = 0; i < npre && ok; i++) ok = iv_push(&L->par, pre[i]) && iv_add(&h->m[pre[i]].vis, s);
+    for (int i = 0; tail && i < tail->n && ok; i++) {
+        int t = tail->v[i];
+        if (iv_find(&L->par, t) >= 0 || !h->m[t].present) continue;
+        ok = iv_push(&L->par, t) && iv_add(&h->m[t].invis, s);
+    }
+    if (!ok) return HSR_ENOMEM;
+    return hsr_gridlist_insert(h->grid, s, dom->ext);
+}
+
+static void llr_destroy(hsr_ctx *h, int s)
+{
+    llr *L = &h->l[s];
+    hsr_gridlist_remove(h->grid, s);
+    for (int i = 0; i < L->par.n; i++) {
+        iv_del(&h->m[L->par.v[i]].vis, s);
+        iv_del(&h->m[L->par.v[i]].invis, s);
+    }
+    hsr_domain_free(L->dom);
+    L->dom = NULL; L->used = 0; L->par.n = 0; L->nvis = 0;
+    iv_push(&h->freel, s);   /* on failure the slot is just not reused */
+}
+
+static void collect(int id, void *ctx) { iv_push(ctx, id); }
+
+/* ---- adding one MLR domain to the LLR (5.4.2) --------------------- */
+typedef struct add_ctx {
+    const hsr_ctx *h; int id, k; const int *pre; pair_order ord[HSR_MAX_PREFIX];
+    int saw_both, hidden, covered;
+} add_ctx;
+
+static int classify_add(uint64_t db, uint64_t cb, void *vctx)
+{
+    add_ctx *c = vctx;
+    int r = (int)(db & 1), n = (int)((db >> 1) & 1);
+    if (r && !n) return 0;
+    if (!r) return n ? 1 : -1;
+    if (!n) return 0;
+    c->saw_both = 1;
+    int pos = 0;
+    while (pos < c->k && !c->ord[pos].p_front_side[(cb >> pos) & 1]) pos++;
+    if (pos == c->k && (OPAQUE(c->h, c->pre[c->k - 1]) || c->k >= HSR_MAX_PREFIX)) { c->hidden = 1; return 1; }
+    if (pos == 0 && OPAQUE(c->h, c->id)) { c->covered = 1; return 0; }
+    return 2 + pos;
+}
+
+static hsr_status add_domain(hsr_ctx *h, int id)
+{
+    hsr_status st = HSR_OK;
+    mlr *M = &h->m[id];
+    if (hsr_domain_is_empty(M->dom)) return HSR_OK;
+    hsr_domain *rem = hsr_domain_clone(M->dom);
+    ivec cand = {0, 0, 0}, acc = {0, 0, 0}, tail = {0, 0, 0};
+    if (!rem) return HSR_ENOMEM;
+    hsr_gridlist_query(h->grid, rem->ext, collect, &cand);
+    for (int ci = 0; ci < cand.n && !hsr_domain_is_empty(rem); ci++) {
+        int s = cand.v[ci];
+        llr *N = &h->l[s];
+        if (!N->used || !hsr_extent_overlap(rem->ext, N->dom->ext)) continue;
+        add_ctx c;
+        memset(&c, 0, sizeof c);
+        c.h = h; c.id = id; c.k = N->nvis; c.pre = N->par.v;
+        sweep_in in[2 + HSR_MAX_PREFIX];
+        edge cuts[HSR_MAX_PREFIX];
+        int64_t hy[HSR_MAX_PREFIX];
+        int hb[HSR_MAX_PREFIX], nin = 2, nh = 0;
+        in[0] = (sweep_in){rem->e, rem->n, 0};
+        in[1] = (sweep_in){N->dom->e, N->dom->n, 1};
+        for (int j = 0; j < c.k; j++) {
+            const mlr *P = &h->m[c.pre[j]];
+            pair_order_make(M->plane, M->dom->ext, id, P->plane, P->dom->ext, c.pre[j], &c.ord[j]);
+            if (!c.ord[j].has_cut) continue;
+            if (c.ord[j].horizontal) { hy[nh] = c.ord[j].hy; hb[nh++] = j; continue; }
+            cuts[j].ln = c.ord[j].cut; cuts[j].y0 = ry_int(c.ord[j].ybot);
+            cuts[j].y1 = ry_int(c.ord[j].ytop); cuts[j].side = 0;
+            in[nin++] = (sweep_in){&cuts[j], 1, 64 + j};
+        }
+        int nlab = c.k + 3;
+        hsr_domain *res[HSR_MAX_PREFIX + 3];
+        st = sweep_overlay(in, nin, hy, hb, nh, classify_add, &c, nlab, res);
+        if (st != HSR_OK) goto done;
+        if (!c.saw_both) { for (int i = 0; i < nlab; i++) hsr_domain_free(res[i]); continue; }
+        hsr_domain_free(rem);
+        rem = res[0];
+        /* N is replaced by its pieces; copy its parents first */
+        int pre[HSR_MAX_PREFIX + 1], k = c.k;
+        memcpy(pre, N->par.v, sizeof(int) * (size_t)k);
+        tail.n = 0;
+        for (int i = k; i < N->par.n; i++) iv_push(&tail, N->par.v[i]);
+        if (c.covered) for (int i = 0; i < N->par.n; i++) if (!iv_add(&acc, N->par.v[i])) st = HSR_ENOMEM;
+        llr_destroy(h, s);
+        if (c.hidden) iv_add(&tail, id);
+        if (!hsr_domain_is_empty(res[1])) { st = llr_create(h, res[1], pre, k, &tail); res[1] = NULL; }
+        if (c.hidden) iv_del(&tail, id);
+        for (int pos = 0; pos <= k; pos++) {
+            hsr_domain *d = res[2 + pos];
+            res[2 + pos] = NULL;
+            if (hsr_domain_is_empty(d)) { hsr_domain_free(d); continue; }
+            int np[HSR_MAX_PREFIX + 1], nn = 0, ntail0 = tail.n;
+            for (int j = 0; j < pos; j++) np[nn++] = pre[j];
+            np[nn++] = id;
+            for (int j = pos; j < k; j++) {
+                if (OPAQUE(h, np[nn - 1]) || nn >= HSR_MAX_PREFIX) iv_add(&tail, pre[j]);
+                else np[nn++] = pre[j];
+            }
+            hsr_status s2 = llr_create(h, d, np, nn, &tail);
+            if (s2 != HSR_OK) st = s2;
+            tail.n = ntail0;
+        }
+        hsr_domain_free(res[1]);
+        if (st != HSR_OK) goto done;
+    }
+    if (!hsr_domain_is_empty(rem)) { st = llr_create(h, rem, &id, 1, &acc); rem = NULL; }
+done:
+    hsr_domain_free(rem);
+    free(cand.v); free(acc.v); free(tail.v);
+    return st;
+}
+
+/* ---- removal with damage repair (5.4.5) --------------------------- */
+static hsr_status remove_domain(hsr_ctx *h, int X, ivec *R)
+{
+    ivec L = {0, 0, 0};
+    char *inL = calloc((size_t)h->nl + 1, 1), *inR = calloc((size_t)h->nm + 1, 1);
+    hsr_status st = HSR_ENOMEM;
+    if (!inL || !inR) goto done;
+    for (int i = 0; i < h->m[X].vis.n; i++) {
+        int s = h->m[X].vis.v[i];
+        if (!inL[s]) { inL[s] = 1; if (!iv_push(&L, s)) goto done; }
+    }
+    for (int il = 0, ir = 0; il < L.n || ir < R->n;) {
+        while (il < L.n) {
+            const llr *N = &h->l[L.v[il++]];
+            for (int i = 0; i < N->par.n; i++) {
+                int p = N->par.v[i];
+                if (p != X && !inR[p]) { inR[p] = 1; if (!iv_push(R, p)) goto done; }
+            }
+        }
+        while (ir < R->n) {
+            const mlr *P = &h->m[R->v[ir++]];
+            for (int i = 0; i < P->vis.n; i++) {
+                int s = P->vis.v[i];
+                if (!inL[s]) { inL[s] = 1; if (!iv_push(&L, s)) goto done; }
+            }
+        }
+    }
+    while (h->m[X].invis.n) {   /* X was hidden there: just drop it */
+        int s = h->m[X].invis.v[0];
+        if (inL[s]) { iv_del(&h->m[X].invis, s); continue; }
+        iv_del(&h->l[s].par, X);
+        iv_del(&h->m[X].invis, s);
+    }
+    for (int i = 0; i < L.n; i++) llr_destroy(h, L.v[i]);
+    st = HSR_OK;
+done:
+    free(L.v); free(inL); free(inR);
+    return st;
+}
+
+static int cmp_int(const void *a, const void *b) { return *(const int *)a - *(const int *)b; }
+
+static hsr_status readd(hsr_ctx *h, ivec *R)
+{
+    qsort(R->v, (size_t)R->n, sizeof(int), cmp_int);
+    for (int i = 0; i < R->n; i++) {
+        hsr_status st = add_domain(h, R->v[i]);
+        if (st != HSR_OK) return st;
+    }
+    return HSR_OK;
+}
+
+/* ---- public operations --------------------------------------------- */
+static int plane_ok(hsr_plane p) { return isfinite(p.a) && isfinite(p.b) && isfinite(p.c); }
+static int id_ok(const hsr_ctx *h, int id) { return h && id >= 0 && id < h->nm && h->m[id].present; }
+
+hsr_status hsr_add(hsr_ctx *h, const int64_t *xy, const int *ring_len, int nrings,
+                   hsr_plane plane, double opacity, int *id_out)
+{
+    if (!h || !plane_ok(plane) || !(opacity >= 0.0 && opacity <= 1.0)) return HSR_EINVAL;
+    hsr_domain *d;
+    hsr_status st = hsr_domain_from_rings(xy, ring_len, nrings, &d);
+    if (st != HSR_OK) return st;
+    if (h->nm == h->capm) {
+        int c = h->capm ? h->capm * 2 : 64;
+        mlr *q = realloc(h->m, sizeof(mlr) * (size_t)c);
+        if (!q) { hsr_domain_free(d); return HSR_ENOMEM; }
+        h->m = q; h->capm = c;
+    }
+    int id = h->nm++;
+    memset(&h->m[id], 0, sizeof(mlr));
+    h->m[id].present = 1; h->m[id].dom = d; h->m[id].plane = plane; h->m[id].opacity = opacity;
+    if (id_out) *id_out = id;
+    return add_domain(h, id);
+}
+
+hsr_status hsr_remove(hsr_ctx *h, int id)
+{
+    if (!id_ok(h, id)) return HSR_ENOTFOUND;
+    ivec R = {0, 0, 0};
+    hsr_status st = remove_domain(h, id, &R);
+    h->m[id].present = 0;
+    hsr_domain_free(h->m[id].dom);
+    h->m[id].dom = NULL;
+    if (st == HSR_OK) st = readd(h, &R);
+    free(R.v);
+    return st;
+}
+
+static hsr_status change(hsr_ctx *h, int id, hsr_domain *nd, const hsr_plane *np, double op)
+{
+    ivec R = {0, 0, 0};
+    hsr_status st = remove_domain(h, id, &R);
+    h->m[id].present = 0;
+    if (st == HSR_OK) st = readd(h, &R);
+    free(R.v);
+    h->m[id].present = 1;
+    if (nd) { hsr_domain_free(h->m[id].dom); h->m[id].dom = nd; }
+    if (np) h->m[id].plane = *np;
+    if (op >= 0) h->m[id].opacity = op;
+    if (st == HSR_OK) st = add_domain(h, id);
+    return st;
+}
+
+hsr_status hsr_move(hsr_ctx *h, int id, const int64_t *xy, const int *ring_len,
+                    int nrings, hsr_plane plane)
+{
+    if (!id_ok(h, id)) return HSR_ENOTFOUND;
+    if (!plane_ok(plane)) return HSR_EINVAL;
+    hsr_domain *d;
+    hsr_status st = hsr_domain_from_rings(xy, ring_len, nrings, &d);
+    if (st != HSR_OK) return st;
+    return change(h, id, d, &plane, -1);
+}
+
+hsr_status hsr_set_opacity(hsr_ctx *h, int id, double opacity)
+{
+    if (!id_ok(h, id)) return HSR_ENOTFOUND;
+    if (!(opacity >= 0.0 && opacity <= 1.0)) return HSR_EINVAL;
+    return change(h, id, NULL, NULL, opacity);
+}
+
+hsr_status hsr_rebuild(hsr_ctx *h)
+{
+    if (!h) return HSR_EINVAL;
+    for (int s = 0; s < h->nl; s++) if (h->l[s].used) llr_destroy(h, s);
+    for (int i = 0; i < h->nm; i++) {
+        if (!h->m[i].present) continue;
+        hsr_status st = add_domain(h, i);
+        if (st != HSR_OK) return st;
+    }
+    return HSR_OK;
+}
+
+hsr_status hsr_pick(const hsr_ctx *h, int64_t x, int64_t y, hsr_pick_mode mode, int *id_out)
+{
+    if (!h || !id_out) return HSR_EINVAL;
+    ivec cand = {0, 0, 0};
+    hsr_extent q = {x, y, x, y};
+    hsr_gridlist_query(h->grid, q, collect, &cand);
+    int found = -1;
+    for (int i = 0; i < cand.n && found < 0; i++)
+        if (hsr_domain_contains(h->l[cand.v[i]].dom, x, y)) found = cand.v[i];
+    free(cand.v);
+    if (found < 0) return HSR_ENOTFOUND;
+    const llr *L = &h->l[found];
+    if (mode == HSR_PICK_VISIBLE) { *id_out = L->par.v[0]; return HSR_OK; }
+    if (mode == HSR_PICK_FIRST_OPAQUE) {
+        for (int i = 0; i < L->nvis; i++) if (OPAQUE(h, L->par.v[i])) { *id_out = L->par.v[i]; return HSR_OK; }
+        return HSR_ENOTFOUND;
+    }
+    if (mode != HSR_PICK_NEXT_BEHIND) return HSR_EINVAL;
+    if (L->nvis > 1) { *id_out = L->par.v[1]; return HSR_OK; }
+    int best = -1;
+    double bz = 0;
+    for (int i = L->nvis; i < L->par.n; i++) {   /* nearest hidden parent at (x,y) */
+        const mlr *P = &h->m[L->par.v[i]];
+        if (!hsr_domain_contains(P->dom, x, y)) continue;
+        double z = P->plane.a * (double)x + P->plane.b * (double)y + P->plane.c;
+        if (best < 0 || z < bz) { best = L->par.v[i]; bz = z; }
+    }
+    if (best < 0) return HSR_ENOTFOUND;
+    *id_out = best;
+    return HSR_OK;
+}
+
+int hsr_llr_slots(const hsr_ctx *h) { return h ? h->nl : 0; }
+int hsr_mlr_slots(const hsr_ctx *h) { return h ? h->nm : 0; }
+
+int hsr_llr_get(const hsr_ctx *h, int slot, const hsr_domain **dom, const int **parents,
+                int *nvis, int *npar)
+{
+    if (!h || slot < 0 || slot >= h->nl || !h->l[slot].used) return 0;
+    const llr *L = &h->l[slot];
+    if (dom) *dom = L->dom;
+    if (parents) *parents = L->par.v;
+    if (nvis) *nvis = L->nvis;
+    if (npar) *npar = L->par.n;
+    return 1;
+}
+
+int hsr_mlr_get(const hsr_ctx *h, int id, const hsr_domain **dom, hsr_plane *plane,
+                double *opacity, int *nvisibles, int *ninvisibles)
+{
+    if (!id_ok(h, id)) return 0;
+    const mlr *M = &h->m[id];
+    if (dom) *dom = M->dom;
+    if (plane) *plane = M->plane;
+    if (opacity) *opacity = M->opacity;
+    if (nvisibles) *nvisibles = M->vis.n;
+    if (ninvisibles) *ninvisibles = M->invis.n;
+    return 1;
+}
+
+hsr_status hsr_check(const hsr_ctx *h)
+{
+    if (!h) return HSR_EINVAL;
+    for (int s = 0; s < h->nl; s++) {
+        const llr *L = &h->l[s];
+        if (!L->used) continue;
+        if (L->nvis < 1 || L->nvis > L->par.n || hsr_domain_is_empty(L->dom)) return HSR_EINVAL;
+        for (int i = 0; i < L->par.n; i++) {
+            int p = L->par.v[i];
+            if (!id_ok(h, p)) return HSR_EINVAL;
+            if (i < L->nvis - 1 && OPAQUE(h, p)) return HSR_EINVAL;
+            const ivec *lst = i < L->nvis ? &h->m[p].vis : &h->m[p].invis;
+            if (iv_find(lst, s) < 0) return HSR_EINVAL;
+        }
+    }
+    for (int id = 0; id < h->nm; id++) {
+        const mlr *M = &h->m[id];
+        if (!M->present) { if (M->vis.n || M->invis.n) return HSR_EINVAL; continue; }
+        for (int i = 0; i < M->vis.n; i++) {
+            const llr *L = &h->l[M->vis.v[i]];
+            int j = iv_find(&L->par, id);
+            if (!L->used || j < 0 || j >= L->nvis) return HSR_EINVAL;
+        }
+        for (int i = 0; i < M->invis.n; i++) {
+            const llr *L = &h->l[M->invis.v[i]];
+            int j = iv_find(&L->par, id);
+            if (!L->used || j < L->nvis) return HSR_EINVAL;
+        }
+    }
+    return HSR_OK;
+}

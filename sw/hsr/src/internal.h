@@ -1,0 +1,69 @@
+/* internal.h - private types shared by the sw/hsr sources. */
+#ifndef HSR_INTERNAL_H
+#define HSR_INTERNAL_H
+
+#include "hsr.h"
+
+typedef __int128 i128;
+
+/* Line x*dy - y*dx = k, dy > 0, gcd(dx,dy) == 1 (canonical, so equal
+ * lines compare equal).  |dx|,|dy| <= 2^24, |k| <= 2^48. */
+typedef struct line { int64_t dx, dy, k; } line;
+
+/* Rational y = p/q, q > 0; |p| <= 2^73, q <= 2^49 (see docs/hsr.md). */
+typedef struct ry { i128 p; int64_t q; } ry;
+
+/* Edge of a domain: the part of `ln` with y0 <= y <= y1 (y0 < y1).
+ * side = +1: interior to the right (a left boundary), -1: to the left. */
+typedef struct edge { line ln; ry y0, y1; int side; } edge;
+
+struct hsr_domain {
+    int n, cap;
+    edge *e;       /* Sorted-Edge order */
+    hsr_extent ext;
+};
+
+/* exact.c */
+int line_make(int64_t x0, int64_t y0, int64_t x1, int64_t y1, line *out);
+int line_eq(const line *a, const line *b);
+int line_cmp(const line *a, const line *b);      /* total order */
+ry ry_int(int64_t v);
+int ry_cmp(ry a, ry b);
+int line_cross_y(const line *a, const line *b, ry *y); /* 0 if parallel */
+int x_cmp_at(const line *a, const line *b, ry y);   /* sign(xa(y)-xb(y)) */
+int x_cmp_int(const line *a, ry y, int64_t x);      /* sign(xa(y)-x) */
+double ry_d(ry y);
+double x_at_d(const line *a, ry y);
+int64_t ry_floor(ry y);
+int64_t ry_ceil(ry y);
+int64_t x_floor(const line *a, ry y);
+int64_t x_ceil(const line *a, ry y);
+
+/* domain.c */
+hsr_domain *dom_new(void);
+int dom_push(hsr_domain *d, const edge *e);
+void dom_finish_extent(hsr_domain *d);
+
+/* sweep.c - overlay of up to 64 sources (even-odd each) and 64 cut lines.
+ * classify(dom_bits, cut_bits, ctx) -> label in [0,nlabels) or -1.
+ * Cut lines split areas but do not change coverage; a horizontal cut
+ * (src >= 64 + 64) is given by hcut_y.  Output domains out[0..nlabels-1]
+ * are created (possibly empty). */
+typedef struct sweep_in {
+    const edge *e; int n; int src;   /* src < 64: domain bit, else cut bit */
+} sweep_in;
+typedef int (*sweep_classify)(uint64_t dom_bits, uint64_t cut_bits, void *ctx);
+hsr_status sweep_overlay(const sweep_in *in, int nin, const int64_t *hcut_y,
+                         const int *hcut_bit, int nhcut, sweep_classify fn,
+                         void *ctx, int nlabels, hsr_domain **out);
+
+/* separate.c: depth order of surface p vs q, with the optional cut line */
+typedef struct pair_order {
+    int has_cut, horizontal;  /* horizontal: cut is y = hy */
+    line cut; int64_t hy, ybot, ytop;
+    int p_front_side[2];      /* [side] -> 1 if p is in front; side 1 = right/above */
+} pair_order;
+void pair_order_make(hsr_plane pp, hsr_extent ep, int idp,
+                     hsr_plane pq, hsr_extent eq, int idq, pair_order *o);
+
+#endif
