@@ -252,7 +252,7 @@ static int cmp_int(const void *a, const void *b) { return *(const int *)a - *(co
 
 static hsr_status readd(hsr_ctx *h, ivec *R)
 {
-    qsort(R->v, (size_t)R->n, sizeof(int), cmp_int);
+    if (R->n > 1) qsort(R->v, (size_t)R->n, sizeof(int), cmp_int);
     for (int i = 0; i < R->n; i++) {
         hsr_status st = add_domain(h, R->v[i]);
         if (st != HSR_OK) return st;

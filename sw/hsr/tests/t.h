@@ -28,4 +28,10 @@ void suite_hsr(void);
 void suite_props(void);
 void suite_io(void);
 int fuzz_run(int iterations, unsigned long long seed);
+
+/* test_hsr.c helpers */
+hsr_ctx *t_ctx(void);
+int t_add_rect(hsr_ctx *h, int64_t l, int64_t b, int64_t r, int64_t t, double za, double zc, double op);
+double t_visible_area(const hsr_ctx *h, int id);   /* area where id is prefix[0] */
+double t_llr_total_area(const hsr_ctx *h);
 #endif
