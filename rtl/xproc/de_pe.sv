@@ -1,0 +1,433 @@
+// Difference Engine: one x-processor (PE) of the linear systolic array.
+//
+// Micro-architecture: docs/xproc.md. Instruction set: docs/isa.md (normative).
+// Cycle-level reference: sw/diffengine/structural.py (same register names; the
+// testbench tb/de_pe compares every register of every PE every cycle).
+//
+// Skew: a slot's identifier and data block 0 arrive together in cycle t ("stage 0");
+// its block j arrives in cycle t+j ("stage j"). data_i therefore carries block 0 of
+// the slot named by id_i, block 1 of the slot before it, block 2 of the slot before
+// that. The 36-bit add is three 12-bit adds, one per stage, with registered block
+// carries: no carry ripples through more than 12 bits in one cycle.
+
+module de_pe
+  import de_pkg::*;
+#(
+  // 1 = reproduce the prototype's carry fault (isa.md section 7): the carry out of
+  // block 1 enters block 2 at bit 1 (adds 2) instead of bit 0.
+  parameter int unsigned CarryBug = 0
+) (
+  input  logic             clk_i,
+  input  logic             rst_i,        // synchronous, active high
+  input  logic [IdW-1:0]   id_i,         // identifier of the slot at stage 0
+  input  logic [DataW-1:0] data_i,       // skewed: [j*12 +: 12] = block j of stage j's slot
+  output logic [IdW-1:0]   id_o,         // registered, to the next PE
+  output logic [DataW-1:0] data_o,       // registered, to the next PE (same skew)
+  output logic             pix_valid_o,  // registered: a Refresh's pixel this cycle
+  output logic [PixW-1:0]  pix_o,        // registered: D[35:24], zero when not valid
+  output logic [DbgW-1:0]  dbg_o         // all state, for the testbench (unused in a chip)
+);
+
+  // ---- elaboration checks ------------------------------------------------------------
+  if (CarryBug > 1) begin : g_bad_carry_bug
+    $fatal(1, "de_pe: CarryBug must be 0 or 1, got %0d", CarryBug);
+  end
+  if (!id_layout_ok()) begin : g_bad_id_layout
+    $fatal(1, "de_pkg: id_t does not match the Id*Bit positions");
+  end
+
+  // ---- registers (every one is a _d/_q pair) -------------------------------------------
+  // Architectural: A, B, C, D as three 12-bit blocks, the flags.
+  logic [NumBlk-1:0][BlkW-1:0] a_d, a_q, b_d, b_q, c_d, c_q, d_d, d_q;
+  logic pa_d, pa_q, pb_d, pb_q, pc_d, pc_q;  // protect flags (set by a Set)
+  logic dis_d, dis_q;                        // Dis pending for the next active Eval
+  logic lock_d, lock_q;                      // Eval0 wrote D: no D write until Refresh
+  logic accm_d, accm_q;                      // Acc_mode: drop negative intensities
+  logic act_d, act_q;                        // this PE is selected by the current command
+  // Registered outputs to the next PE; id_q doubles as the stage-1 identifier.
+  logic [IdW-1:0] id_d, id_q;
+  logic [NumBlk-1:0][BlkW-1:0] out_d, out_q;
+  // Control pipeline: decisions taken for block 0 (stage 0/1), used for blocks 1 and 2.
+  logic [IdW-1:0] id2_d, id2_q;              // stage-2 identifier
+  logic xz1_d, xz1_q;                        // range address: X was 0
+  logic act1_d, act1_q, prot1_d, prot1_q;    // stage-1 slot: active / use DST (protected)
+  logic c1_d, c1_q;                          // data adder: carry block 0 -> block 1
+  logic act2_d, act2_q, prot2_d, prot2_q;    // stage-2 slot: active / protected
+  logic c2_d, c2_q;                          // data adder: carry block 1 -> block 2
+  logic e0wr2_d, e0wr2_q;                    // Eval0 writes D in stage 2
+  logic accen2_d, accen2_q, accc2_d, accc2_q;  // ACC: write D block 1 / its carry in
+  logic accen3_d, accen3_q, accc3_d, accc3_q;  // ACC: write D block 2 / its carry in
+  logic pixv_d, pixv_q;
+  logic [PixW-1:0] pix_d, pix_q;
+
+  // ---- inputs and decode -------------------------------------------------------------
+  logic [NumBlk-1:0][BlkW-1:0] in_blk;
+  id_t id0;
+  // Later stages decode only the fields they act on (protection is decided at stage 0,
+  // addressing needs blocks 0-1 only), so some identifier bits are unused there.
+  /* verilator lint_off UNUSEDSIGNAL */
+  id_t id1, id2;
+  /* verilator lint_on UNUSEDSIGNAL */
+  assign in_blk = data_i;
+  assign id0 = id_t'(id_i);
+  assign id1 = id_t'(id_q);
+  assign id2 = id_t'(id2_q);
+
+  // Register read port: code RegNone reads as zero ("adds 0").
+  function automatic logic [BlkW-1:0] sel_reg(input logic [1:0] code,
+                                              input logic [BlkW-1:0] a,
+                                              input logic [BlkW-1:0] b,
+                                              input logic [BlkW-1:0] c);
+    case (code)
+      RegA:    return a;
+      RegB:    return b;
+      RegC:    return c;
+      default: return '0;
+    endcase
+  endfunction
+
+  function automatic logic sel_flag(input logic [1:0] code, input logic a,
+                                    input logic b, input logic c);
+    case (code)
+      RegA:    return a;
+      RegB:    return b;
+      RegC:    return c;
+      default: return 1'b0;
+    endcase
+  endfunction
+
+  // Weight of the block-1 carry as it enters block 2: bit 0 normally, bit 1 with the
+  // fault (the prototype wired the carry one position too high).
+  function automatic logic [BlkW:0] carry_in2(input logic c);
+    return (BlkW + 1)'(c) << CarryBug;
+  endfunction
+
+  // ---- stage 1 address decision (needed first: it sets act for stage 0) --------------
+  logic per1, fire_per1, fire_rng1, fire1, act_eff;
+  assign per1      = id1.addr && (id1.sub == SubPeriodic);
+  assign fire_per1 = (in_blk[1] == '0);                 // countdown reached 0
+  assign fire_rng1 = xz1_q && (in_blk[1] != '0);        // X was 0 and dX > 0
+  assign fire1     = id1.addr && (per1 ? fire_per1 : fire_rng1);
+  // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
+  // sees that slot's decision at once; later slots of the command see the act register.
+  assign act_eff   = id1.addr ? fire1 : act_q;
+
+  // ---- stage 0: identifier + block 0 ---------------------------------------------------
+  logic ev0, st0, rng0, xz0, prot0, active0, wr0;
+  logic [BlkW-1:0] v0, out0;
+  logic [BlkW:0] s0;
+  assign ev0     = id0.data && !id0.set;
+  assign st0     = id0.data && id0.set;
+  assign rng0    = id0.addr && (id0.sub != SubPeriodic);
+  assign xz0     = (in_blk[0] == '0);
+  // Protection is decided once per slot, here, and travels with it down the pipeline.
+  assign prot0   = ev0 && act_eff && id0.prot && sel_flag(id0.dst, pa_q, pb_q, pc_q);
+  assign active0 = ev0 && act_eff;
+  assign v0      = prot0 ? sel_reg(id0.dst, a_q[0], b_q[0], c_q[0]) : in_blk[0];
+  assign s0      = {1'b0, v0} + {1'b0, sel_reg(id0.src, a_q[0], b_q[0], c_q[0])};
+  assign wr0     = (ev0 || st0) && act_eff && (id0.dst != RegNone);
+
+  always_comb begin
+    out0 = in_blk[0];
+    if (rng0) begin
+      // Relative addressing: count X down to 0 and keep it there.
+      out0 = xz0 ? '0 : in_blk[0] - BlkW'(1);
+    end
+    if (active0) begin
+      out0 = s0[BlkW-1:0];
+    end
+  end
+
+  // ---- stage 1: block 1 ------------------------------------------------------------------
+  logic ev1, st1, active1, wr1, dis1, e0_1, e0en1;
+  logic [BlkW-1:0] v1, out1;
+  logic [BlkW:0] s1;
+  assign ev1     = id1.data && !id1.set;
+  assign st1     = id1.data && id1.set;
+  assign active1 = ev1 && act1_q;
+  assign v1      = prot1_q ? sel_reg(id1.dst, a_q[1], b_q[1], c_q[1]) : in_blk[1];
+  assign s1      = {1'b0, v1} + {1'b0, sel_reg(id1.src, a_q[1], b_q[1], c_q[1])}
+                 + (BlkW + 1)'(c1_q);
+  assign wr1     = (ev1 || st1) && act1_q && (id1.dst != RegNone);
+  assign dis1    = id1.addr && (id1.sub == SubDis) && fire1;
+  assign e0_1    = id1.addr && (id1.sub == SubEval0) && fire1;
+  assign e0en1   = e0_1 && !lock_q && !dis_q;
+
+  always_comb begin
+    out1 = in_blk[1];
+    if (per1) begin
+      // Periodic: reload the countdown with P-1 from out_q block 0, which still holds
+      // the period this slot passed on unchanged one cycle ago (no extra register).
+      out1 = fire_per1 ? out_q[0] - BlkW'(1) : in_blk[1] - BlkW'(1);
+    end else if (id1.addr && fire_rng1) begin
+      out1 = in_blk[1] - BlkW'(1);
+    end
+    if (active1) begin
+      out1 = s1[BlkW-1:0];
+    end
+  end
+
+  // ---- stage 2: block 2 ------------------------------------------------------------------
+  logic ev2, st2, active2, wr2;
+  logic [BlkW-1:0] v2, out2;
+  // The carry out of block 2 (bit 35) is dropped: arithmetic wraps modulo 2^36.
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [BlkW:0] s2;
+  /* verilator lint_on UNUSEDSIGNAL */
+  assign ev2     = id2.data && !id2.set;
+  assign st2     = id2.data && id2.set;
+  assign active2 = ev2 && act2_q;
+  assign v2      = prot2_q ? sel_reg(id2.dst, a_q[2], b_q[2], c_q[2]) : in_blk[2];
+  assign s2      = {1'b0, v2} + {1'b0, sel_reg(id2.src, a_q[2], b_q[2], c_q[2])}
+                 + carry_in2(c2_q);
+  assign wr2     = (ev2 || st2) && act2_q && (id2.dst != RegNone);
+  assign out2    = active2 ? s2[BlkW-1:0] : in_blk[2];
+
+  // ---- accumulator: ACC decided in its stage 1, D block j written in stage j+1 ----------
+  // The decision waits one cycle because Acc_mode needs the sign of A (bit 35), which is
+  // block 2 of the intensity written by the slot just before the ACC, in this cycle.
+  logic a2_sign_next, acc_act1, accen1;
+  logic [BlkW:0] sa0, sa1;
+  // The carry out of block 2 (bit 35) is dropped: arithmetic wraps modulo 2^36.
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [BlkW:0] sa2;
+  /* verilator lint_on UNUSEDSIGNAL */
+  always_comb begin
+    a2_sign_next = a_q[2][BlkW-1];
+    if (wr2 && (id2.dst == RegA)) begin
+      a2_sign_next = v2[BlkW-1];
+    end
+    if (id2.refresh) begin
+      a2_sign_next = 1'b0;
+    end
+  end
+  assign acc_act1 = id1.acc && act1_q;
+  assign accen1   = acc_act1 && !lock_q && !dis_q && !(accm_q && a2_sign_next);
+  assign sa0 = {1'b0, d_q[0]} + {1'b0, a_q[0]};
+  assign sa1 = {1'b0, d_q[1]} + {1'b0, a_q[1]} + (BlkW + 1)'(accc2_q);
+  assign sa2 = {1'b0, d_q[2]} + {1'b0, a_q[2]} + carry_in2(accc3_q);
+
+  // D's next value before a Refresh clear. Eval0 wins over an ACC write of the same
+  // cycle: an ACC can only coincide with an Eval0 that follows it in the stream.
+  logic [NumBlk-1:0][BlkW-1:0] d_next;
+  always_comb begin
+    d_next = d_q;
+    if (accen1) begin
+      d_next[0] = sa0[BlkW-1:0];
+    end
+    if (accen2_q) begin
+      d_next[1] = sa1[BlkW-1:0];
+    end
+    if (accen3_q) begin
+      d_next[2] = sa2[BlkW-1:0];
+    end
+    if (e0wr2_q) begin
+      d_next = {in_blk[2], {(2 * BlkW) {1'b0}}};
+    end
+  end
+
+  // ---- register file next state ------------------------------------------------------------
+  always_comb begin
+    a_d = a_q;
+    b_d = b_q;
+    c_d = c_q;
+    d_d = d_next;
+    // Block j of a data slot is written in its stage j (only one slot per stage).
+    if (wr0) begin
+      case (id0.dst)
+        RegA:    a_d[0] = v0;
+        RegB:    b_d[0] = v0;
+        default: c_d[0] = v0;
+      endcase
+    end
+    if (wr1) begin
+      case (id1.dst)
+        RegA:    a_d[1] = v1;
+        RegB:    b_d[1] = v1;
+        default: c_d[1] = v1;
+      endcase
+    end
+    if (wr2) begin
+      case (id2.dst)
+        RegA:    a_d[2] = v2;
+        RegB:    b_d[2] = v2;
+        default: c_d[2] = v2;
+      endcase
+    end
+    // A Refresh clears block j of A-D in its stage j; the clear wins over any write.
+    if (id0.refresh) begin
+      a_d[0] = '0;
+      b_d[0] = '0;
+      c_d[0] = '0;
+      d_d[0] = '0;
+    end
+    if (id1.refresh) begin
+      a_d[1] = '0;
+      b_d[1] = '0;
+      c_d[1] = '0;
+      d_d[1] = '0;
+    end
+    if (id2.refresh) begin
+      a_d[2] = '0;
+      b_d[2] = '0;
+      c_d[2] = '0;
+      d_d[2] = '0;
+    end
+  end
+
+  // ---- flags next state -----------------------------------------------------------------
+  logic no_class0;
+  assign no_class0 = !(id0.addr || id0.data || id0.acc || id0.refresh);
+
+  always_comb begin
+    pa_d   = pa_q;
+    pb_d   = pb_q;
+    pc_d   = pc_q;
+    dis_d  = dis_q;
+    lock_d = lock_q;
+    accm_d = accm_q;
+    // Stage-1 writes first: they belong to the older slot.
+    if (dis1) begin
+      dis_d = 1'b1;
+    end
+    if (e0en1) begin
+      lock_d = 1'b1;
+    end
+    if (e0_1 || acc_act1) begin
+      // The Eval (Eval0 or ACC) active in this PE consumes the Sets and the Dis.
+      pa_d  = 1'b0;
+      pb_d  = 1'b0;
+      pc_d  = 1'b0;
+      dis_d = 1'b0;
+    end
+    // Stage-0 writes last: the younger slot wins a same-cycle conflict.
+    if (st0 && act_eff) begin
+      case (id0.dst)
+        RegA:    pa_d = 1'b1;
+        RegB:    pb_d = 1'b1;
+        RegC:    pc_d = 1'b1;
+        default: ;
+      endcase
+    end
+    if (no_class0 && (id0.sub == SubAccModeOn)) begin
+      accm_d = 1'b1;
+    end
+    if (no_class0 && (id0.sub == SubAccModeOff)) begin
+      accm_d = 1'b0;
+    end
+    if (id0.refresh) begin
+      pa_d   = 1'b0;
+      pb_d   = 1'b0;
+      pc_d   = 1'b0;
+      dis_d  = 1'b0;
+      lock_d = 1'b0;
+      accm_d = 1'b0;
+    end
+  end
+
+  // Only data and ACC slots keep act; every other slot ends the command (isa.md sec. 5).
+  assign act_d = (id0.data || id0.acc) && act_eff;
+
+  // ---- pipeline next state ----------------------------------------------------------------
+  assign id_d     = id_i;
+  assign out_d    = {out2, out1, out0};
+  assign id2_d    = id_q;
+  assign xz1_d    = rng0 && xz0;
+  assign act1_d   = act_eff;
+  assign prot1_d  = prot0;
+  assign c1_d     = active0 && s0[BlkW];
+  assign act2_d   = act1_q;
+  assign prot2_d  = prot1_q;
+  assign c2_d     = active1 && s1[BlkW];
+  assign e0wr2_d  = e0en1;
+  assign accen2_d = accen1;
+  assign accc2_d  = accen1 && sa0[BlkW];
+  assign accen3_d = accen2_q;
+  assign accc3_d  = accen2_q && sa1[BlkW];
+  // Pixel: D block 2 as it stands at the end of the Refresh's stage 2 without the
+  // Refresh's own clear (forwards an ACC written in the same cycle); zero when not
+  // valid so that a chip can OR the pixel outputs of its PEs.
+  assign pixv_d   = id2.refresh;
+  assign pix_d    = id2.refresh ? d_next[2] : '0;
+
+  // ---- flip-flops ------------------------------------------------------------------------
+  // Synchronous reset: it maps onto the FPGA flops' local set/reset with no
+  // recovery/removal timing to close, and it makes reset just another clock cycle,
+  // exactly as the structural model treats it.
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      a_q      <= '0;
+      b_q      <= '0;
+      c_q      <= '0;
+      d_q      <= '0;
+      pa_q     <= 1'b0;
+      pb_q     <= 1'b0;
+      pc_q     <= 1'b0;
+      dis_q    <= 1'b0;
+      lock_q   <= 1'b0;
+      accm_q   <= 1'b0;
+      act_q    <= 1'b0;
+      id_q     <= '0;
+      out_q    <= '0;
+      id2_q    <= '0;
+      xz1_q    <= 1'b0;
+      act1_q   <= 1'b0;
+      prot1_q  <= 1'b0;
+      c1_q     <= 1'b0;
+      act2_q   <= 1'b0;
+      prot2_q  <= 1'b0;
+      c2_q     <= 1'b0;
+      e0wr2_q  <= 1'b0;
+      accen2_q <= 1'b0;
+      accc2_q  <= 1'b0;
+      accen3_q <= 1'b0;
+      accc3_q  <= 1'b0;
+      pixv_q   <= 1'b0;
+      pix_q    <= '0;
+    end else begin
+      a_q      <= a_d;
+      b_q      <= b_d;
+      c_q      <= c_d;
+      d_q      <= d_d;
+      pa_q     <= pa_d;
+      pb_q     <= pb_d;
+      pc_q     <= pc_d;
+      dis_q    <= dis_d;
+      lock_q   <= lock_d;
+      accm_q   <= accm_d;
+      act_q    <= act_d;
+      id_q     <= id_d;
+      out_q    <= out_d;
+      id2_q    <= id2_d;
+      xz1_q    <= xz1_d;
+      act1_q   <= act1_d;
+      prot1_q  <= prot1_d;
+      c1_q     <= c1_d;
+      act2_q   <= act2_d;
+      prot2_q  <= prot2_d;
+      c2_q     <= c2_d;
+      e0wr2_q  <= e0wr2_d;
+      accen2_q <= accen2_d;
+      accc2_q  <= accc2_d;
+      accen3_q <= accen3_d;
+      accc3_q  <= accc3_d;
+      pixv_q   <= pixv_d;
+      pix_q    <= pix_d;
+    end
+  end
+
+  // ---- outputs ----------------------------------------------------------------------------
+  assign id_o        = id_q;
+  assign data_o      = out_q;
+  assign pix_valid_o = pixv_q;
+  assign pix_o       = pix_q;
+
+  // Layout = DBG_FIELDS in sw/diffengine/structural.py, MSB first.
+  assign dbg_o = {a_q, b_q, c_q, d_q,
+                  pa_q, pb_q, pc_q, dis_q, lock_q, accm_q, act_q,
+                  id_q, id2_q, out_q,
+                  xz1_q, act1_q, prot1_q, c1_q, act2_q, prot2_q, c2_q,
+                  e0wr2_q, accen2_q, accc2_q, accen3_q, accc3_q,
+                  pixv_q, pix_q};
+
+endmodule
