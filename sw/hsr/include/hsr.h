@@ -155,4 +155,35 @@ int hsr_mlr_get(const hsr_ctx *h, int id, const hsr_domain **dom,
 /* Check internal consistency (administration lists, grid). */
 hsr_status hsr_check(const hsr_ctx *h);
 
+/* ---- scenes: Wavefront OBJ + scene file (docs/hsr.md) ------------- */
+typedef struct hsr_material { char name[64]; double rgb[3]; double opacity; } hsr_material;
+typedef struct hsr_face { int first, count, material; } hsr_face;
+
+typedef struct hsr_scene {
+    double *v; int nv, capv;          /* world x,y,z per vertex */
+    int *fv; int nfv, capfv;          /* 0-based vertex indices of faces */
+    hsr_face *f; int nf, capf;
+    hsr_material *mat; int nmat, capmat;  /* mat[0] is "default" */
+    int width, height, grid;
+    double eye[3], at[3], up[3], fov_deg, near_z;
+    double light[3], light_i, ambient, bg[3];
+} hsr_scene;
+
+/* err receives "file:line: message" on failure (may be NULL). */
+hsr_status hsr_scene_new(hsr_scene **out);
+void hsr_scene_free(hsr_scene *sc);
+hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name,
+                         int material, char *err, size_t errlen);
+hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name,
+                           const char *dir, char *err, size_t errlen);
+hsr_status hsr_scene_load(const char *path, hsr_scene **out, char *err, size_t errlen);
+/* Viewing + perspective + near/screen clipping; MLR id i == face i (a
+ * face clipped away or seen edge-on becomes an empty domain).  shade
+ * receives 4 doubles per face: r, g, b (lit) and opacity; free() it. */
+hsr_status hsr_scene_build(const hsr_scene *sc, hsr_ctx **out, double **shade);
+/* --dump-llr JSON and SVG writers (schema in docs/hsr.md). */
+hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scene *sc);
+hsr_status hsr_write_svg(const char *path, const hsr_ctx *h, const hsr_scene *sc,
+                         const double *shade);
+
 #endif

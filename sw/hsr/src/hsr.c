@@ -159,7 +159,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         in[1] = (sweep_in){N->dom->e, N->dom->n, 1};
         for (int j = 0; j < c.k; j++) {
             const mlr *P = &h->m[c.pre[j]];
-            pair_order_make(M->plane, M->dom->ext, id, P->plane, P->dom->ext, c.pre[j], &c.ord[j]);
+            pair_order_make(M->dom, M->plane, id, P->dom, P->plane, c.pre[j], &c.ord[j]);
             if (!c.ord[j].has_cut) continue;
             if (c.ord[j].horizontal) { hy[nh] = c.ord[j].hy; hb[nh++] = j; continue; }
             cuts[j].ln = c.ord[j].cut; cuts[j].y0 = ry_int(c.ord[j].ybot);

@@ -63,7 +63,12 @@ typedef struct pair_order {
     line cut; int64_t hy, ybot, ytop;
     int p_front_side[2];      /* [side] -> 1 if p is in front; side 1 = right/above */
 } pair_order;
-void pair_order_make(hsr_plane pp, hsr_extent ep, int idp,
-                     hsr_plane pq, hsr_extent eq, int idq, pair_order *o);
+void pair_order_make(const hsr_domain *dp, hsr_plane pp, int idp,
+                     const hsr_domain *dq, hsr_plane pq, int idq, pair_order *o);
+
+/* obj.c helpers shared with scene.c */
+int scene_grow(void **p, int *cap, int need, size_t sz);
+int scene_tokens(char *line, char **tok, int max);
+int scene_num(const char *s, double *v);
 
 #endif

@@ -20,8 +20,22 @@ static int64_t clampc(double v)
 }
 
 /* canonical: p has the lower id */
-static void order_canon(hsr_plane pp, hsr_extent ep, int idp, hsr_plane pq,
-                        hsr_extent eq, int idq, pair_order *o)
+/* an input edge line within 1 unit of the crossing (a shared edge) */
+static int edge_near(const hsr_domain *d, const double *px, const double *py, double *best, line *bl)
+{
+    int found = 0;
+    for (int i = 0; d && i < d->n; i++) {
+        const line *L = &d->e[i].ln;
+        double len = hypot((double)L->dx, (double)L->dy);
+        double d0 = fabs(px[0] * L->dy - py[0] * L->dx - (double)L->k) / len;
+        double d1 = fabs(px[1] * L->dy - py[1] * L->dx - (double)L->k) / len;
+        if (fmax(d0, d1) < *best) { *best = fmax(d0, d1); *bl = *L; found = 1; }
+    }
+    return found;
+}
+
+static void order_canon(const hsr_domain *dp, hsr_plane pp, hsr_extent ep, int idp,
+                        const hsr_domain *dq, hsr_plane pq, hsr_extent eq, int idq, pair_order *o)
 {
     int tie = idp < idq;
     o->has_cut = 0; o->horizontal = 0;
@@ -57,14 +71,16 @@ static void order_canon(hsr_plane pp, hsr_extent ep, int idp, hsr_plane pq,
     int front_c = fc < 0 ? 1 : (fc > 0 ? 0 : tie);
     o->p_front_side[0] = o->p_front_side[1] = front_c;
     if (np < 2) return;
-    int64_t x0 = clampc(px[0]), y0 = clampc(py[0]), x1 = clampc(px[1]), y1 = clampc(py[1]);
-    if (x0 == x1 && y0 == y1) return;
     if (b.bot == b.top) return;
+    int64_t x0 = clampc(px[0]), y0 = clampc(py[0]), x1 = clampc(px[1]), y1 = clampc(py[1]);
     double D = (double)(b.right - b.left) + (double)(b.top - b.bot) + 16;
-    double mx = (x0 + x1) / 2.0, my = (y0 + y1) / 2.0, nx, ny;
-    if (y0 == y1) { o->horizontal = 1; o->hy = y0; nx = 0; ny = 1; }
+    double mx = (px[0] + px[1]) / 2.0, my = (py[0] + py[1]) / 2.0, nx, ny, best = 1.0;
+    int shared = edge_near(dp, px, py, &best, &o->cut);
+    shared |= edge_near(dq, px, py, &best, &o->cut);
+    if (!shared && x0 == x1 && y0 == y1) return;
+    if (!shared && y0 == y1) { o->horizontal = 1; o->hy = y0; nx = 0; ny = 1; }
     else {
-        if (!line_make(x0, y0, x1, y1, &o->cut)) return;
+        if (!shared && !line_make(x0, y0, x1, y1, &o->cut)) return;
         double len = hypot((double)o->cut.dx, (double)o->cut.dy);
         nx = o->cut.dy / len; ny = -o->cut.dx / len;   /* points to the right */
     }
@@ -75,11 +91,12 @@ static void order_canon(hsr_plane pp, hsr_extent ep, int idp, hsr_plane pq,
     o->has_cut = 1;
 }
 
-void pair_order_make(hsr_plane pp, hsr_extent ep, int idp,
-                     hsr_plane pq, hsr_extent eq, int idq, pair_order *o)
+void pair_order_make(const hsr_domain *dp, hsr_plane pp, int idp,
+                     const hsr_domain *dq, hsr_plane pq, int idq, pair_order *o)
 {
-    if (idp <= idq) { order_canon(pp, ep, idp, pq, eq, idq, o); return; }
-    order_canon(pq, eq, idq, pp, ep, idp, o);
+    hsr_extent ep = hsr_domain_extent(dp), eq = hsr_domain_extent(dq);
+    if (idp <= idq) { order_canon(dp, pp, ep, idp, dq, pq, eq, idq, o); return; }
+    order_canon(dq, pq, eq, idq, dp, pp, ep, idp, o);
     o->p_front_side[0] = !o->p_front_side[0];
     o->p_front_side[1] = !o->p_front_side[1];
 }
@@ -114,8 +131,7 @@ hsr_status hsr_separate(const hsr_surface *A, const hsr_surface *B, hsr_separati
     out->kind = HSR_SEP_DISJOINT;
     if (!A || !B || !A->dom || !B->dom || !plane_ok(A->plane) || !plane_ok(B->plane)) return HSR_EINVAL;
     pair_order o;
-    pair_order_make(A->plane, hsr_domain_extent(A->dom), A->id, B->plane,
-                    hsr_domain_extent(B->dom), B->id, &o);
+    pair_order_make(A->dom, A->plane, A->id, B->dom, B->plane, B->id, &o);
     /* labels: 0 = A side, 1 = B side, 2 = A n_B B, 3 = B n_A A */
     sep_ctx c = {&o, {0, 1, 0, 1}, 0};
     hsr_sep_case kind = HSR_SEP_OPAQUE;

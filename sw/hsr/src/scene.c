@@ -1,0 +1,172 @@
+/* scene.c - the scene file (camera, lights, materials, objects); the
+ * format is defined in docs/hsr.md.  Errors name file and line. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "internal.h"
+
+#define MAX_FILE (256L << 20)
+
+hsr_status hsr_scene_new(hsr_scene **out)
+{
+    if (!out) return HSR_EINVAL;
+    hsr_scene *sc = calloc(1, sizeof *sc);
+    if (!sc) return HSR_ENOMEM;
+    sc->width = 640; sc->height = 480; sc->grid = 32;
+    sc->eye[2] = 5; sc->up[1] = 1; sc->fov_deg = 60; sc->near_z = 0.1;
+    sc->light[0] = 1; sc->light[1] = 1; sc->light[2] = 1; sc->light_i = 0.8; sc->ambient = 0.2;
+    sc->bg[0] = sc->bg[1] = sc->bg[2] = 1;
+    if (!scene_grow((void **)&sc->mat, &sc->capmat, 1, sizeof(hsr_material))) { free(sc); return HSR_ENOMEM; }
+    hsr_material d = {"default", {0.8, 0.8, 0.8}, 1.0};
+    sc->mat[0] = d; sc->nmat = 1;
+    *out = sc;
+    return HSR_OK;
+}
+
+void hsr_scene_free(hsr_scene *sc)
+{
+    if (!sc) return;
+    free(sc->v); free(sc->fv); free(sc->f); free(sc->mat); free(sc);
+}
+
+static hsr_status read_file(const char *path, char **text)
+{
+    *text = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) return HSR_EIO;
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    for (;;) {
+        if (cap - n < 65536) {
+            if (cap > (size_t)MAX_FILE) { free(buf); fclose(f); return HSR_ELIMIT; }
+            char *q = realloc(buf, cap + 65536 + 1);
+            if (!q) { free(buf); fclose(f); return HSR_ENOMEM; }
+            buf = q; cap += 65536;
+        }
+        size_t r = fread(buf + n, 1, cap - n, f);
+        n += r;
+        if (r == 0) break;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) { free(buf); return HSR_EIO; }
+    buf[n] = 0;
+    if (strlen(buf) != n) { free(buf); return HSR_EPARSE; }   /* NUL byte */
+    *text = buf;
+    return HSR_OK;
+}
+
+static int nums(char **tok, int n, double *out)
+{
+    for (int i = 0; i < n; i++) if (!scene_num(tok[i], &out[i])) return 0;
+    return 1;
+}
+
+hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, const char *dir,
+                           char *err, size_t errlen)
+{
+    if (!sc || !text) return HSR_EINVAL;
+    if (!name) name = "<scene>";
+    int lineno = 0;
+    char buf[4096], *tok[64];
+    const char *p = text;
+    while (*p) {
+        const char *e = strchr(p, '\n');
+        size_t n = e ? (size_t)(e - p) : strlen(p);
+        lineno++;
+#define FAIL(st, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", name, lineno); \
+        if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } return st; } while (0)
+        if (n >= sizeof buf) FAIL(HSR_EPARSE, "line too long");
+        memcpy(buf, p, n); buf[n] = 0;
+        p = e ? e + 1 : p + n;
+        int nt = scene_tokens(buf, tok, 64);
+        if (nt < 0) FAIL(HSR_EPARSE, "too many items on one line");
+        if (nt == 0) continue;
+        double v[16];
+        const char *k = tok[0];
+        if (!strcmp(k, "screen")) {
+            if (nt != 3 || !nums(tok + 1, 2, v) || v[0] < 1 || v[1] < 1 || v[0] > 32767 || v[1] > 32767
+                || v[0] != (int)v[0] || v[1] != (int)v[1])
+                FAIL(HSR_EPARSE, "'screen W H' needs integers in 1..32767");
+            sc->width = (int)v[0]; sc->height = (int)v[1];
+        } else if (!strcmp(k, "grid")) {
+            if (nt != 2 || !nums(tok + 1, 1, v) || v[0] < 1 || v[0] > 4096 || v[0] != (int)v[0])
+                FAIL(HSR_EPARSE, "'grid N' needs an integer in 1..4096");
+            sc->grid = (int)v[0];
+        } else if (!strcmp(k, "camera")) {
+            if (nt != 15 || strcmp(tok[1], "eye") || strcmp(tok[5], "at") || strcmp(tok[9], "up")
+                || strcmp(tok[13], "fov"))
+                FAIL(HSR_EPARSE, "expected 'camera eye X Y Z at X Y Z up X Y Z fov DEG'");
+            double c[10];
+            if (!nums(tok + 2, 3, c) || !nums(tok + 6, 3, c + 3) || !nums(tok + 10, 3, c + 6) || !nums(tok + 14, 1, c + 9))
+                FAIL(HSR_EPARSE, "bad or non-finite number in camera");
+            if (!(c[9] > 1 && c[9] < 179)) FAIL(HSR_EPARSE, "fov must be in (1, 179) degrees");
+            memcpy(sc->eye, c, sizeof sc->eye); memcpy(sc->at, c + 3, sizeof sc->at);
+            memcpy(sc->up, c + 6, sizeof sc->up); sc->fov_deg = c[9];
+        } else if (!strcmp(k, "near")) {
+            if (nt != 2 || !nums(tok + 1, 1, v) || !(v[0] > 0)) FAIL(HSR_EPARSE, "'near D' needs D > 0");
+            sc->near_z = v[0];
+        } else if (!strcmp(k, "light")) {
+            if (nt != 5 || !nums(tok + 1, 4, v)) FAIL(HSR_EPARSE, "'light DX DY DZ I' needs 4 finite numbers");
+            memcpy(sc->light, v, sizeof sc->light); sc->light_i = v[3];
+        } else if (!strcmp(k, "ambient")) {
+            if (nt != 2 || !nums(tok + 1, 1, v)) FAIL(HSR_EPARSE, "'ambient A' needs a finite number");
+            sc->ambient = v[0];
+        } else if (!strcmp(k, "background")) {
+            if (nt != 4 || !nums(tok + 1, 3, v)) FAIL(HSR_EPARSE, "'background R G B' needs 3 numbers");
+            memcpy(sc->bg, v, sizeof sc->bg);
+        } else if (!strcmp(k, "material")) {
+            if ((nt != 5 && nt != 7) || !nums(tok + 2, 3, v) || (nt == 7 && (strcmp(tok[5], "opacity") || !nums(tok + 6, 1, v + 3))))
+                FAIL(HSR_EPARSE, "expected 'material NAME R G B [opacity A]'");
+            if (nt == 5) v[3] = 1;
+            if (!(v[3] >= 0 && v[3] <= 1)) FAIL(HSR_EPARSE, "opacity must be in [0,1]");
+            if (strlen(tok[1]) >= 64) FAIL(HSR_EPARSE, "material name too long");
+            if (!scene_grow((void **)&sc->mat, &sc->capmat, sc->nmat + 1, sizeof(hsr_material))) FAIL(HSR_ENOMEM, "out of memory");
+            hsr_material *m = &sc->mat[sc->nmat++];
+            snprintf(m->name, sizeof m->name, "%s", tok[1]);
+            m->rgb[0] = v[0]; m->rgb[1] = v[1]; m->rgb[2] = v[2]; m->opacity = v[3];
+        } else if (!strcmp(k, "obj")) {
+            if (nt != 2 && !(nt == 4 && !strcmp(tok[2], "material"))) FAIL(HSR_EPARSE, "expected 'obj PATH [material NAME]'");
+            int mat = 0;
+            if (nt == 4) {
+                mat = -1;
+                for (int i = 0; i < sc->nmat; i++) if (!strcmp(sc->mat[i].name, tok[3])) mat = i;
+                if (mat < 0) FAIL(HSR_EPARSE, "unknown material '%s'", tok[3]);
+            }
+            char path[4096];
+            if (tok[1][0] == '/' || !dir) snprintf(path, sizeof path, "%s", tok[1]);
+            else snprintf(path, sizeof path, "%s/%s", dir, tok[1]);
+            char *text2;
+            hsr_status st = read_file(path, &text2);
+            if (st != HSR_OK) FAIL(st, "cannot read OBJ file '%s' (%s)", path, hsr_status_str(st));
+            st = hsr_obj_parse(sc, text2, path, mat, err, errlen);
+            free(text2);
+            if (st != HSR_OK) return st;
+        } else FAIL(HSR_EPARSE, "unknown statement '%s'", k);
+#undef FAIL
+    }
+    return HSR_OK;
+}
+
+hsr_status hsr_scene_load(const char *path, hsr_scene **out, char *err, size_t errlen)
+{
+    if (!path || !out) return HSR_EINVAL;
+    *out = NULL;
+    char *text;
+    hsr_status st = read_file(path, &text);
+    if (st != HSR_OK) {
+        if (err) snprintf(err, errlen, "%s: cannot read (%s)", path, hsr_status_str(st));
+        return st;
+    }
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash) *slash = 0; else snprintf(dir, sizeof dir, ".");
+    hsr_scene *sc;
+    st = hsr_scene_new(&sc);
+    if (st == HSR_OK) st = hsr_scene_parse(sc, text, path, dir, err, errlen);
+    free(text);
+    if (st != HSR_OK) { hsr_scene_free(sc); return st; }
+    *out = sc;
+    return HSR_OK;
+}
