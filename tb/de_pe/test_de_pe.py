@@ -197,10 +197,13 @@ def directed_cases() -> list[tuple[str, list, list | None]]:
     f = FIX
     cases = [
         ("nop", [C("NOP"), C("NOP")], z),
+        # Dis / Set directly before the Refresh: the next case fails if dis / pA survive
+        ("dis_then_refresh", [C("EVAL", 0, 9, f), C("DIS", 0, 9)], [1] * 9),
         ("eval0", [C("EVAL0", 2, 3, 100)], [0, 0, 100, 100, 100, 0, 0, 0, 0]),
         ("eval0_dx0", [C("EVAL0", 2, 0, 100)], z),
         ("eval0_first_wins", [C("EVAL0", 1, 2, 5), C("EVAL0", 0, 4, 9)],
          [9, 5, 5, 9, 0, 0, 0, 0, 0]),
+        ("seti_then_refresh", [C("SETI", 0, 9, 7 * f)], z),
         ("eval1", [C("EVAL", 1, 4, 5 * f)], [0, 5, 5, 5, 5, 0, 0, 0, 0]),
         ("eval1_past_end", [C("EVAL", 7, 100, 3 * f)], [0] * 7 + [3, 3]),
         ("eval1_x_beyond", [C("EVAL", 12, 3, 3 * f)], z),
@@ -234,6 +237,8 @@ def directed_cases() -> list[tuple[str, list, list | None]]:
         ("acc_then_seti", [C("EVAL", 0, 9, 2 * f), C("SETI", 1, 1, 5 * f),
                            C("EVAL", 0, 9, f)], None),
         ("dis_then_eval", [C("DIS", 0, 9), C("EVAL", 0, 9, f)], z),
+        ("acc_then_dis", [C("EVAL", 0, 9, f), C("DIS", 0, 9), C("EVAL", 0, 9, 2 * f)],
+         [1] * 9),
         ("eval0_then_eval0", [C("EVAL0", 0, 9, 3), C("EVAL0", 0, 9, 4)], [3] * 9),
         ("eval0_then_dis", [C("EVAL0", 0, 1, 3), C("DIS", 1, 1), C("EVAL", 0, 9, f)],
          [3, 0, 1, 1, 1, 1, 1, 1, 1]),
