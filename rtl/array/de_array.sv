@@ -1,0 +1,111 @@
+// Difference Engine: the x-processor array, NumChips chips of nine PEs in a line.
+//
+//   ident_i/data_i (one instruction per clock, unskewed)
+//     -> de_skew -> chip 0 -> chip 1 -> ... -> chip NumChips-1 -> de_deskew -> ident_o/data_o
+//   pixels leave the last chip in column order, one per clock (pixel_valid_o/pixel_o).
+//
+// Latency (docs/array.md): the pixel of column q of a Refresh that enters at cycle t
+// leaves at t + q + NumChips + PixLatency0, where q counts only PEs that are not
+// bypassed. Two Refreshes must be at least n_pe_o cycles apart (7.4.1: one Refresh
+// active at a time); pix_collision_o flags a violation and stays set until reset.
+module de_array
+  import de_pkg::*;
+#(
+  parameter int unsigned NumChips  = 72,   // 648 PEs: 640 columns plus spares (7.8)
+  parameter int unsigned CarryBug  = 0,
+  parameter int unsigned NumPe     = 9,    // PEs per chip (the source's chip has 9)
+  // Test only: chip c's PE i is faulty when bit c*NumPe+i is set (bypass test).
+  parameter logic [1023:0] FaultMask = '0
+) (
+  input  logic             clk_i,
+  input  logic             rst_i,
+  input  logic [IdW-1:0]   ident_i,
+  input  logic [DataW-1:0] data_i,
+  output logic [IdW-1:0]   ident_o,
+  output logic [DataW-1:0] data_o,
+  output logic             pixel_valid_o,
+  output logic [PixW-1:0]  pixel_o,
+  output logic [15:0]      n_pe_o,           // PEs built (bypassed ones included)
+  output logic             pix_collision_o,
+  input  logic             cfg_mode_i,
+  input  logic             cfg_bit_i,
+  output logic             cfg_bit_o,
+  input  logic             obs_load_i,
+  input  logic             obs_shift_i,
+  output logic             obs_bit_o
+);
+  if (NumChips < 1 || NumChips * NumPe > 4096) begin : g_bad_size
+    // 12-bit X and dX address at most 4096 columns (7.4.2).
+    $fatal(1, "de_array: NumChips*NumPe must be 1..4096, got %0d", NumChips * NumPe);
+  end
+  if (CarryBug > 1) begin : g_bad_carry_bug
+    $fatal(1, "de_array: CarryBug must be 0 or 1");
+  end
+
+  logic [NumChips:0][IdW-1:0]   id_c;
+  logic [NumChips:0][DataW-1:0] data_c;
+  logic [NumChips:0]            pixv_c, cfg_c, obs_c;
+  logic [NumChips:0][PixW-1:0]  pix_c;
+  logic [NumChips-1:0]          coll_c;
+  // Bypass bits per chip: visible in waves and to testbenches through the hierarchy.
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [NumChips-1:0][NumPe-1:0] bypass_c;
+  /* verilator lint_on UNUSEDSIGNAL */
+  logic [11:0] skew_id;
+  logic [11:0] skew_b0, skew_b1, skew_b2;
+
+  de_skew u_skew (
+    .clk_i, .rst_i, .ident_i, .data_i,
+    .ident_o(skew_id), .blk0_o(skew_b0), .blk1_o(skew_b1), .blk2_o(skew_b2)
+  );
+  assign id_c[0]   = skew_id;
+  assign data_c[0] = {skew_b2, skew_b1, skew_b0};
+  assign pixv_c[0] = 1'b0;
+  assign pix_c[0]  = '0;
+  assign cfg_c[0]  = cfg_bit_i;
+  assign obs_c[0]  = 1'b0;
+
+  for (genvar c = 0; c < NumChips; c++) begin : g_chip
+    de_chip #(
+      .NumPe    (NumPe),
+      .CarryBug (CarryBug),
+      .FaultMask(32'(FaultMask[c*NumPe +: NumPe]))
+    ) u_chip (
+      .clk_i, .rst_i,
+      .id_i       (id_c[c]),     .data_i     (data_c[c]),
+      .id_o       (id_c[c+1]),   .data_o     (data_c[c+1]),
+      .pix_valid_i(pixv_c[c]),   .pix_i      (pix_c[c]),
+      .pix_valid_o(pixv_c[c+1]), .pix_o      (pix_c[c+1]),
+      .cfg_mode_i,
+      .cfg_bit_i  (cfg_c[c]),    .cfg_bit_o  (cfg_c[c+1]),
+      .obs_load_i, .obs_shift_i,
+      .obs_bit_i  (obs_c[c]),    .obs_bit_o  (obs_c[c+1]),
+      .bypass_o   (bypass_c[c]),
+      .collision_o(coll_c[c])
+    );
+  end
+
+  de_deskew u_deskew (
+    .clk_i, .rst_i,
+    .ident_i(id_c[NumChips]),
+    .blk0_i (data_c[NumChips][11:0]),
+    .blk1_i (data_c[NumChips][23:12]),
+    .blk2_i (data_c[NumChips][35:24]),
+    .ident_o, .data_o
+  );
+
+  logic coll_d, coll_q;
+  assign coll_d = coll_q | (|coll_c);
+  always_ff @(posedge clk_i) begin
+    if (rst_i) coll_q <= 1'b0;
+    else       coll_q <= coll_d;
+  end
+
+  assign pixel_valid_o   = pixv_c[NumChips];
+  assign pixel_o         = pix_c[NumChips];
+  assign n_pe_o          = 16'(NumChips * NumPe);
+  assign pix_collision_o = coll_q;
+  assign cfg_bit_o       = cfg_c[NumChips];
+  // The last chip's words come out first; within a chip, PE 0's word first.
+  assign obs_bit_o       = obs_c[NumChips];
+endmodule

@@ -1,0 +1,156 @@
+// Difference Engine: one chip of nine x-processors (Kuijk 1995, 7.4.5, Fig. 7.7).
+//
+// Bus:    id/data (skewed blocks) -> PE 0 -> ... -> PE 8 -> boundary register -> out.
+// Pixels: pix_i (from the upstream chip) OR the nine PEs' pixels -> boundary register.
+// The boundary registers keep the combinational depth independent of the chip count.
+// Because both buses gain exactly one register per chip, a pixel of column q leaves the
+// last chip at (Refresh entry) + q + NumChips + const for every q: raster order with no
+// gap and no collision (docs/array.md derives it).
+//
+// Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
+// PE passes the bus straight through (no register, so it adds no latency) and its pixel
+// output is masked; relative addressing makes the remaining PEs a smaller array.
+// Observation (7.4.5): a second serial register that loads each PE's controller outputs
+// (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
+module de_chip
+  import de_pkg::*;
+#(
+  parameter int unsigned NumPe     = 9,
+  parameter int unsigned CarryBug  = 0,
+  // Test only: PEs whose bus output is corrupted (bit i = PE i), to show bypass works.
+  parameter logic [31:0] FaultMask = '0
+) (
+  input  logic             clk_i,
+  input  logic             rst_i,
+  input  logic [IdW-1:0]   id_i,
+  input  logic [DataW-1:0] data_i,
+  output logic [IdW-1:0]   id_o,
+  output logic [DataW-1:0] data_o,
+  input  logic             pix_valid_i,
+  input  logic [PixW-1:0]  pix_i,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
+  // configuration chain: shifts one bit per clock while cfg_mode_i
+  input  logic             cfg_mode_i,
+  input  logic             cfg_bit_i,
+  output logic             cfg_bit_o,
+  // observation chain: parallel load on obs_load_i, shift one bit per clock on obs_shift_i
+  input  logic             obs_load_i,
+  input  logic             obs_shift_i,
+  input  logic             obs_bit_i,
+  output logic             obs_bit_o,
+  output logic [NumPe-1:0] bypass_o,    // current configuration, for tests and waves
+  // Two pixels met on the chain this cycle (registered): two Refreshes were closer
+  // than the array is wide, breaking "one Refresh active at a time" (7.4.1).
+  output logic             collision_o
+);
+  // Observation word per PE: {pA,pB,pC,dis,lock,acc_mode,act,id1} and the 12 control
+  // pipeline bits {xz1 .. accc3}; positions follow dbg_o (structural.DBG_FIELDS).
+  localparam int unsigned ObsW     = 31;
+  localparam int unsigned DbgPixLo = 0;                        // pix, pix_valid: 13 bits
+  localparam int unsigned DbgCtlLo = DbgPixLo + PixW + 1;      // 12 control bits
+  localparam int unsigned DbgIdLo  = DbgCtlLo + 12 + DataW + IdW;  // id1 above out, id2
+  localparam int unsigned DbgObsHi = DbgIdLo + IdW + 7 - 1;    // 7 flags above id1
+
+  if (NumPe < 1 || NumPe > 32) begin : g_bad_num_pe
+    $fatal(1, "de_chip: NumPe must be 1..32, got %0d", NumPe);
+  end
+
+  logic [NumPe:0][IdW-1:0]   bus_id;
+  logic [NumPe:0][DataW-1:0] bus_data;
+  logic [NumPe:0][PixW-1:0]  pix_or;
+  logic [NumPe:0]            pixv_or;
+  logic [NumPe-1:0]          coll;
+  logic [NumPe-1:0]          byp_d, byp_q;
+  logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
+
+  assign bus_id[0]   = id_i;
+  assign bus_data[0] = data_i;
+  assign pix_or[0]   = pix_valid_i ? pix_i : '0;
+  assign pixv_or[0]  = pix_valid_i;
+
+  for (genvar i = 0; i < NumPe; i++) begin : g_pe
+    logic [IdW-1:0]   pe_id;
+    logic [DataW-1:0] pe_data;
+    logic             pe_pixv;
+    logic [PixW-1:0]  pe_pix;
+    // Only the observation fields of the debug vector are used inside a chip.
+    /* verilator lint_off UNUSEDSIGNAL */
+    logic [DbgW-1:0]  pe_dbg;
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    de_pe #(.CarryBug(CarryBug)) u_pe (
+      .clk_i, .rst_i,
+      .id_i       (bus_id[i]),
+      .data_i     (bus_data[i]),
+      .id_o       (pe_id),
+      .data_o     (pe_data),
+      .pix_valid_o(pe_pixv),
+      .pix_o      (pe_pix),
+      .dbg_o      (pe_dbg)
+    );
+
+    // A bypassed PE is a wire; a faulty one (test parameter) garbles what it passes on.
+    assign bus_id[i+1]   = byp_q[i] ? bus_id[i]   : pe_id;
+    assign bus_data[i+1] = byp_q[i] ? bus_data[i] :
+                           (FaultMask[i] ? ~pe_data : pe_data);
+    // At most one PE of the whole array drives a pixel in a cycle, so OR is a mux.
+    assign pix_or[i+1]  = pix_or[i]  | ((pe_pixv && !byp_q[i]) ? pe_pix : '0);
+    assign pixv_or[i+1] = pixv_or[i] | (pe_pixv && !byp_q[i]);
+    assign coll[i]      = pixv_or[i] && pe_pixv && !byp_q[i];
+    assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgObsHi:DbgIdLo], pe_dbg[DbgCtlLo +: 12]};
+  end
+
+  // Configuration shift register: enters at PE 0, leaves after PE NumPe-1.
+  // {byp_q, cfg_bit_i} shifted by one; its top bit is the one leaving (cfg_bit_o).
+  logic [NumPe:0] byp_shifted;
+  assign byp_shifted = {byp_q, cfg_bit_i};
+  always_comb begin
+    byp_d = byp_q;
+    if (cfg_mode_i) byp_d = byp_shifted[NumPe-1:0];
+  end
+  assign cfg_bit_o = byp_shifted[NumPe];
+  assign bypass_o  = byp_q;
+
+  // Observation shift register: PE 0's word shifts out first, LSB first.
+  always_comb begin
+    obs_d = obs_q;
+    if (obs_load_i) obs_d = obs_load;
+    else if (obs_shift_i) obs_d = {obs_bit_i, obs_q[NumPe*ObsW-1:1]};
+  end
+  assign obs_bit_o = obs_q[0];
+
+  // Boundary registers.
+  logic [IdW-1:0]   id_q;
+  logic [DataW-1:0] data_q;
+  logic             pixv_q;
+  logic [PixW-1:0]  pix_q;
+  logic             coll_q;
+
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      byp_q  <= '0;
+      obs_q  <= '0;
+      id_q   <= '0;
+      data_q <= '0;
+      pixv_q <= 1'b0;
+      pix_q  <= '0;
+      coll_q <= 1'b0;
+    end else begin
+      byp_q  <= byp_d;
+      obs_q  <= obs_d;
+      id_q   <= bus_id[NumPe];
+      data_q <= bus_data[NumPe];
+      pixv_q <= pixv_or[NumPe];
+      pix_q  <= pix_or[NumPe];
+      coll_q <= |coll;
+    end
+  end
+
+  assign id_o        = id_q;
+  assign data_o      = data_q;
+  assign pix_valid_o = pixv_q;
+  assign pix_o       = pix_q;
+  assign collision_o = coll_q;
+
+endmodule
