@@ -1,0 +1,148 @@
+// Difference Engine - video timing generator (part of the Access Controller, Kuijk 1995
+// §7.5; design and mode table in docs/display-controller.md).
+//
+// Counts h (pixel slots) and v (lines) in the *issue* time base: the cycle in which
+// (h, v) is current is the cycle in which the Access Controller decides what goes on
+// the instruction bus for that slot. The Refresh of line v is decided at h = 0. The
+// sync/blank outputs here are therefore early; de_access_ctrl delays them to match the
+// array.
+//
+// Line layout (both axes): [0, Active) active, then front porch, sync, back porch.
+// mode_i is sampled while rst_i is high and held until the next reset.
+module de_video_timing #(
+  // Mode 3 ("test mode"): small totals for fast simulation and formal checks.
+  parameter int unsigned TestHActive = 16,
+  parameter int unsigned TestHFp     = 2,
+  parameter int unsigned TestHSync   = 3,
+  parameter int unsigned TestHBp     = 3,
+  parameter int unsigned TestVActive = 6,
+  parameter int unsigned TestVFp     = 1,
+  parameter int unsigned TestVSync   = 2,
+  parameter int unsigned TestVBp     = 2
+) (
+  input  logic        clk_i,
+  input  logic        rst_i,
+  input  logic [1:0]  mode_i,
+  // Counters (issue time base).
+  output logic [11:0] h_o,
+  output logic [11:0] v_o,
+  output logic [11:0] h_total_o,
+  output logic [11:0] v_total_o,
+  output logic [11:0] v_active_o,
+  // Undelayed video signals, active high; *pol_o = 1 if the mode's pulse is positive.
+  output logic        hsync_o,
+  output logic        vsync_o,
+  output logic        de_o,
+  output logic        hpol_o,
+  output logic        vpol_o,
+  // Slot qualifiers.
+  output logic        line_start_o,       // h == 0: the Refresh slot
+  output logic        next_active_o,      // line v+1 (mod total) is an active line
+  output logic [11:0] next_line_o         // v+1 (mod total)
+);
+
+  localparam int unsigned TestHTotal = TestHActive + TestHFp + TestHSync + TestHBp;
+  localparam int unsigned TestVTotal = TestVActive + TestVFp + TestVSync + TestVBp;
+
+  // Parameter checks at elaboration.
+  if (TestHActive < 1 || TestHSync < 1 || TestVActive < 1 || TestVSync < 1)
+  begin : gen_err_test_zero
+    $error("de_video_timing: test mode needs non-zero active and sync widths");
+  end
+  if (TestHTotal < 4 || TestHTotal > 4095 || TestVTotal < 2 || TestVTotal > 4095)
+  begin : gen_err_test_total
+    $error("de_video_timing: test mode totals must be in 4..4095 / 2..4095");
+  end
+
+  // Mode table (docs/display-controller.md §3).
+  logic [11:0] h_act, h_fp, h_sync, h_bp, v_act, v_fp, v_sync, v_bp;
+  logic        h_pol, v_pol;  // 1 = active-high sync pulse
+  logic [1:0]  mode_d, mode_q;
+
+  always_comb begin
+    h_act  = 12'd640;  h_fp = 12'd16;  h_sync = 12'd96;  h_bp = 12'd48;
+    v_act  = 12'd480;  v_fp = 12'd10;  v_sync = 12'd2;   v_bp = 12'd33;
+    h_pol  = 1'b0;     v_pol = 1'b0;
+    unique case (mode_q)
+      2'd0: begin  // 640x480@60 (VESA DMT, 25.175 MHz, 800x525)
+      end
+      2'd1: begin  // 640x485 "low resolution" of §7.4.5 (21.5 MHz, 683x525, 59.96 Hz)
+        h_act = 12'd640;  h_fp = 12'd8;   h_sync = 12'd24;  h_bp = 12'd11;
+        v_act = 12'd485;  v_fp = 12'd11;  v_sync = 12'd2;   v_bp = 12'd27;
+      end
+      2'd2: begin  // 1280x1024@60 (VESA DMT, 108 MHz, 1688x1066)
+        h_act = 12'd1280; h_fp = 12'd48;  h_sync = 12'd112; h_bp = 12'd248;
+        v_act = 12'd1024; v_fp = 12'd1;   v_sync = 12'd3;   v_bp = 12'd38;
+        h_pol = 1'b1;     v_pol = 1'b1;
+      end
+      2'd3: begin  // test mode
+        h_act = 12'(TestHActive); h_fp = 12'(TestHFp); h_sync = 12'(TestHSync);
+        h_bp  = 12'(TestHBp);
+        v_act = 12'(TestVActive); v_fp = 12'(TestVFp); v_sync = 12'(TestVSync);
+        v_bp  = 12'(TestVBp);
+      end
+      default: ;
+    endcase
+  end
+
+  // Active lines of a mode, for the reset value (mode_q is not yet loaded then).
+  function automatic logic [11:0] vact_of(logic [1:0] m);
+    unique case (m)
+      2'd1:    vact_of = 12'd485;
+      2'd2:    vact_of = 12'd1024;
+      2'd3:    vact_of = 12'(TestVActive);
+      default: vact_of = 12'd480;
+    endcase
+  endfunction
+
+  logic [11:0] h_total, v_total;
+  logic [11:0] h_d, h_q, v_d, v_q;
+
+  assign h_total = h_act + h_fp + h_sync + h_bp;
+  assign v_total = v_act + v_fp + v_sync + v_bp;
+
+  always_comb begin
+    mode_d = mode_q;
+    h_d    = h_q;
+    v_d    = v_q;
+    if (h_q == h_total - 12'd1) begin
+      h_d = '0;
+      v_d = (v_q == v_total - 12'd1) ? 12'd0 : v_q + 12'd1;
+    end else begin
+      h_d = h_q + 12'd1;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      mode_q <= mode_i;
+      h_q    <= '0;
+      // Start at the first vertical-blank line: the y-processors get a whole vertical
+      // blank to fill their buffers before the window of line 0 opens.
+      v_q    <= vact_of(mode_i);
+    end else begin
+      mode_q <= mode_d;
+      h_q    <= h_d;
+      v_q    <= v_d;
+    end
+  end
+
+  logic h_in_sync, v_in_sync;
+  assign h_in_sync = (h_q >= h_act + h_fp) && (h_q < h_act + h_fp + h_sync);
+  assign v_in_sync = (v_q >= v_act + v_fp) && (v_q < v_act + v_fp + v_sync);
+
+  assign h_o          = h_q;
+  assign v_o          = v_q;
+  assign h_total_o    = h_total;
+  assign v_total_o    = v_total;
+  assign v_active_o   = v_act;
+  assign hsync_o      = h_in_sync;
+  assign vsync_o      = v_in_sync;
+  assign hpol_o       = h_pol;
+  assign vpol_o       = v_pol;
+  assign de_o         = (h_q < h_act) && (v_q < v_act);
+  assign line_start_o = (h_q == 12'd0);
+  assign next_line_o  = (v_q == v_total - 12'd1) ? 12'd0 : v_q + 12'd1;
+  assign next_active_o = (next_line_o < v_act);
+
+endmodule
