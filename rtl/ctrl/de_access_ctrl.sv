@@ -322,8 +322,10 @@ module de_access_ctrl #(
         if (h == 12'd0) assert (f_since_refresh + 16'd1 == 16'(h_total));
         else            assert (f_since_refresh + 16'd1 == 16'(h));
       end else begin
-        assert (16'(h) == f_since_refresh);
+        // Only the first cycle after reset has not seen a Refresh yet.
+        assert (h == 12'd0 && f_since_refresh == '0);
       end
+      assert (32'(owner_q) < NumBuf);
       assert (h_total == 12'(TestHActive + TestHFp + TestHSync + TestHBp));
       assert (v_total == 12'(TestVActive + TestVFp + TestVSync + TestVBp));
       assert (h < h_total && v < v_total);
