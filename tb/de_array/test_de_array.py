@@ -1,0 +1,266 @@
+"""cocotb bench of the x-processor array (chips, boundaries, bypass, observation chain).
+
+driver (instructions, one per clock, Refreshes spaced by the array width)
+  -> monitor (pixels leaving the array; every PE's state through the hierarchy)
+  -> golden models (structural.Array per cycle, functional.render per frame)
+  -> in-order checkers.
+
+Chip k's PEs see the same input stream as the structural model's PEs 9k.., one clock
+later per chip boundary, so their state is compared with the model's history k cycles
+back. Every random test prints its seed; SEED=<n> replays it.
+"""
+from __future__ import annotations
+
+import os
+import random
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from cocotb.clock import Clock
+from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+
+from diffengine import functional, isa, randgen
+from diffengine import structural as st
+
+NUM_PE = 9
+FAULTY = (3, 10)  # PEs garbled by the FaultMask build (bypass test)
+
+
+def chips(dut) -> int:
+    return int(dut.n_pe_o.value) // NUM_PE
+
+
+def spaced(slots, n_pe):
+    """Insert Nops so that two Refreshes are at least n_pe slots apart (7.4.1)."""
+    out, since = [], n_pe
+    for ident, data in slots:
+        if ident == isa.REFRESH:
+            while since < n_pe:
+                out.append((0, 0))
+                since += 1
+            since = 0
+        out.append((ident, data))
+        since += 1
+    return out + [(0, 0)] * (2 * n_pe + 40)
+
+
+class Array:
+    """Drives the DUT and collects pixels; optional per-cycle structural comparison."""
+
+    def __init__(self, dut, check_state: bool = False, carry_bug: bool = False):
+        self.dut = dut
+        self.n = int(dut.n_pe_o.value)
+        self.k = self.n // NUM_PE
+        self.pixels: list[int] = []
+        self.check_state = check_state
+        self.model = st.Array(self.n, carry_bug) if check_state else None
+        self.history: list[list[int]] = []
+        self.cycles_checked = 0
+
+    async def reset(self):
+        d = self.dut
+        for sig in (d.ident_i, d.data_i, d.cfg_mode_i, d.cfg_bit_i, d.obs_load_i,
+                    d.obs_shift_i):
+            sig.value = 0
+        d.rst_i.value = 1
+        for _ in range(3):
+            await RisingEdge(d.clk_i)
+        await FallingEdge(d.clk_i)
+        d.rst_i.value = 0
+        if self.model:
+            self.model.reset()
+
+    async def configure(self, bypass: set[int]):
+        """Shift one bypass bit per PE in; the last PE's bit goes first."""
+        d = self.dut
+        d.cfg_mode_i.value = 1
+        for pe in reversed(range(self.n)):
+            d.cfg_bit_i.value = int(pe in bypass)
+            await FallingEdge(d.clk_i)
+        d.cfg_mode_i.value = 0
+
+    def pe_dbg(self, q: int) -> int:
+        c, i = divmod(q, NUM_PE)
+        return int(self.dut.g_chip[c].u_chip.g_pe[i].pe_dbg.value)
+
+    async def play(self, slots):
+        d = self.dut
+        for ident, data in slots:
+            d.ident_i.value = ident
+            d.data_i.value = data
+            await RisingEdge(d.clk_i)
+            await ReadOnly()
+            if int(d.pixel_valid_o.value):
+                self.pixels.append(int(d.pixel_o.value))
+            if self.model:
+                self.model.step(ident, data)
+                self.history.append(self.model.packed_state())
+                self.compare_state()
+            await FallingEdge(d.clk_i)
+        assert not int(d.pix_collision_o.value), "pixel collision in the array"
+
+    def compare_state(self):
+        t = len(self.history) - 1
+        for q in range(self.n):
+            lag = q // NUM_PE  # one boundary register per chip
+            if t - lag < 0:
+                continue
+            want = self.history[t - lag][q]
+            got = self.pe_dbg(q)
+            if got != want:
+                names = [n for n, _ in st.DBG_FIELDS]
+                diffs = []
+                for name, (lo, w) in zip(names, _field_pos()):
+                    g, e = (got >> lo) & ((1 << w) - 1), (want >> lo) & ((1 << w) - 1)
+                    if g != e:
+                        diffs.append(f"{name}: rtl {g:#x} model {e:#x}")
+                raise AssertionError(f"cycle {t}: PE {q} (chip {q // NUM_PE}) differs from "
+                                     f"the structural model: " + "; ".join(diffs))
+        self.cycles_checked += 1
+
+    def frame(self) -> np.ndarray:
+        assert len(self.pixels) % self.n == 0, f"{len(self.pixels)} pixels, width {self.n}"
+        return np.array(self.pixels, dtype=np.uint16).reshape(-1, self.n)
+
+
+def _field_pos():
+    """(lsb, width) of each DBG_FIELDS entry in the packed debug word (MSB first)."""
+    pos, lsb = [], st.DBG_WIDTH
+    for _, w in st.DBG_FIELDS:
+        lsb -= w
+        pos.append((lsb, w))
+    return pos
+
+
+def seed() -> int:
+    s = int(os.environ.get("SEED", random.randrange(1 << 31)))
+    cocotb.log.info(f"SEED={s} (replay with SEED={s})")
+    return s
+
+
+async def start(dut, **kw) -> Array:
+    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
+    arr = Array(dut, **kw)
+    await arr.reset()
+    return arr
+
+
+def carry_bug(dut) -> bool:
+    return bool(int(os.environ.get("DE_CARRY_BUG", "0")))
+
+
+@cocotb.test()
+async def directed_boundaries(dut):
+    """Spans at PE 0, the last PE, across every chip boundary, dX 0 and 1."""
+    arr = await start(dut)
+    n = arr.n
+    one = 1 << 24
+    cmds = []
+    for b in range(NUM_PE, n, NUM_PE):  # every chip boundary
+        cmds += [isa.Command("EVAL", b - 2, 4, (10 * one, 3 * one, one // 2)),
+                 isa.Command("SETI", b, 1, (100 * one,)), isa.Command("REFRESH")]
+    cmds += [isa.Command("EVAL", 0, 1, (7 * one,)), isa.Command("EVAL", n - 1, 1, (9 * one,)),
+             isa.Command("EVAL", 3, 0, (5 * one,)), isa.Command("EVAL", n - 2, 10, (1, one)),
+             isa.Command("EVAL0", 0, n, (4095,)), isa.Command("REFRESH"),
+             isa.Command("EVAL", 0, n, (0, one // 3, one // 1000)), isa.Command("REFRESH")]
+    await arr.play(spaced(isa.serialise(cmds), n))
+    want = functional.render(cmds, n, carry_bug=carry_bug(dut))
+    np.testing.assert_array_equal(arr.frame(), want)
+
+
+@cocotb.test()
+async def every_pe_every_cycle(dut):
+    """Random streams: all PEs' registers and flags equal the structural model's."""
+    arr = await start(dut, check_state=True, carry_bug=carry_bug(dut))
+    cmds = randgen.stream(seed(), int(os.environ.get("N_STATE", 400)), arr.n, (1, 12))
+    await arr.play(spaced(isa.serialise(cmds), arr.n))
+    np.testing.assert_array_equal(arr.frame(),
+                                  functional.render(cmds, arr.n, carry_bug=carry_bug(dut)))
+    dut._log.info(f"{arr.cycles_checked} cycles x {arr.n} PEs equal the structural model")
+
+
+@cocotb.test()
+async def observation_chain(dut):
+    """Load every PE's controller outputs and shift them out serially (7.4.5)."""
+    arr = await start(dut, check_state=True, carry_bug=carry_bug(dut))
+    rng = random.Random(seed())
+    cmds = [randgen.command(rng, arr.n) for _ in range(30)]
+    slots = isa.serialise(cmds)[:-1]  # stop mid-stream so flags are set
+    await arr.play(slots)
+    d = dut
+    d.ident_i.value, d.data_i.value = 0, 0
+    d.obs_load_i.value = 1
+    await RisingEdge(d.clk_i)   # the load samples the state after the last slot
+    await FallingEdge(d.clk_i)
+    d.obs_load_i.value = 0
+    d.obs_shift_i.value = 1
+    obs_w = 31
+    bits = []
+    for _ in range(arr.n * obs_w):
+        await ReadOnly()
+        bits.append(int(d.obs_bit_o.value))
+        await FallingEdge(d.clk_i)
+    d.obs_shift_i.value = 0
+    # The last chip's words come first; in a chip, PE 0's word first, LSB first.
+    words = [sum(b << i for i, b in enumerate(bits[w * obs_w:(w + 1) * obs_w]))
+             for w in range(arr.n)]
+    order = [c * NUM_PE + i for c in reversed(range(arr.k)) for i in range(NUM_PE)]
+    pos = dict(zip([n for n, _ in st.DBG_FIELDS], _field_pos()))
+    t = len(arr.history) - 1
+    for word, q in zip(words, order):
+        lag = q // NUM_PE
+        dbg = arr.history[t - lag][q]
+        f = lambda name: (dbg >> pos[name][0]) & ((1 << pos[name][1]) - 1)  # noqa: E731
+        flags = 0
+        for name in ("pA", "pB", "pC", "dis", "lock", "acc_mode", "act"):
+            flags = (flags << 1) | f(name)
+        ctl = 0
+        for name in ("xz1", "act1", "prot1", "c1", "act2", "prot2", "c2", "e0wr2",
+                     "accen2", "accc2", "accen3", "accc3"):
+            ctl = (ctl << 1) | f(name)
+        want = (((flags << 12) | f("id1")) << 12) | ctl
+        assert word == want, f"PE {q}: observed {word:#010x}, model {want:#010x}"
+
+
+@cocotb.test()
+async def bypass_equals_smaller_array(dut):
+    """With faulty PEs (and random others) bypassed, the array equals a smaller one."""
+    faulty = set(FAULTY) if int(os.environ.get("DE_FAULTY", "0")) else set()
+    arr = await start(dut)
+    rng = random.Random(seed())
+    bypass = faulty | {q for q in range(arr.n) if rng.random() < 0.25}
+    await arr.configure(bypass)
+    width = arr.n - len(bypass)
+    cmds = randgen.stream(rng.randrange(1 << 30), 600, width, (1, 15))
+    # The array still has n_pe PEs on the bus; the first `width` pixels of a line are
+    # the remaining PEs' and the rest never come (bypassed PEs drive no pixel).
+    await arr.play(spaced(isa.serialise(cmds), arr.n))
+    got = np.array(arr.pixels, dtype=np.uint16).reshape(-1, width)
+    np.testing.assert_array_equal(got, functional.render(cmds, width, carry_bug=carry_bug(dut)))
+    dut._log.info(f"bypassed {sorted(bypass)}: {got.shape[0]} lines equal a {width}-PE array")
+
+
+# ---- pytest runners: one build folder per parameter set --------------------------------
+
+RUNS = [  # (chips, carry_bug, faulty)
+    (1, 0, 0), (2, 0, 0), (2, 1, 0), (2, 0, 1),
+]
+
+
+@pytest.mark.parametrize("chips,bug,faulty", RUNS,
+                         ids=[f"chips{c}_bug{b}_faulty{f}" for c, b, f in RUNS])
+def test_de_array(chips, bug, faulty):
+    from common.run import RTL, build_and_test
+    here = Path(__file__).resolve().parent
+    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
+            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
+            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv"]
+    mask = sum(1 << q for q in FAULTY) if faulty else 0
+    params = {"NumChips": chips, "CarryBug": bug}
+    if faulty:
+        params["FaultMask"] = mask
+    build_and_test(here, "de_array", srcs, "test_de_array", parameters=params,
+                   extra_env={"DE_CARRY_BUG": str(bug), "DE_FAULTY": str(faulty)},
+                   testcase="bypass_equals_smaller_array" if faulty else None)
