@@ -11,11 +11,12 @@ from __future__ import annotations
 import os
 import random
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from diffengine import functional, harness, randgen
+from diffengine import coverage, functional, harness, randgen
 
 N_COMMANDS = int(os.environ.get("N_COMMANDS", 100_000))
 
@@ -30,6 +31,9 @@ def test_random_stream_matches_golden_model(chips, bug):
     # Lines long enough that Refresh padding does not dominate on wide arrays.
     per_line = (1, 40) if width < 100 else (60, 200)
     cmds = randgen.stream(seed, N_COMMANDS, width, per_line)
+    cov = coverage.Coverage(width).add_stream(cmds)
+    (Path(__file__).parent / f"coverage_chips{chips}_bug{bug}.txt").write_text(cov.report() + "\n")
+    print(cov.report(), file=sys.stderr)
     got, report = harness.run(cmds, chips, bool(bug))
     want = functional.render(cmds, width, carry_bug=bool(bug))
     print(report, file=sys.stderr)
@@ -38,3 +42,4 @@ def test_random_stream_matches_golden_model(chips, bug):
     assert bad.size == 0, (
         f"seed {seed}: {len(bad)} pixels differ; first at line {bad[0][0]} column "
         f"{bad[0][1]}: RTL {got[tuple(bad[0])]} model {want[tuple(bad[0])]}")
+    assert not cov.missing(), f"coverage bins not hit: {cov.missing()}"
