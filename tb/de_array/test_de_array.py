@@ -58,6 +58,9 @@ class Array:
         self.model = st.Array(self.n, carry_bug) if check_state else None
         self.history: list[list[int]] = []
         self.cycles_checked = 0
+        self.edge = 0                      # rising edges since play() began
+        self.refresh_edges: list[int] = []  # edge that clocked each Refresh into the array
+        self.pixel_edges: list[int] = []    # edge after which each pixel was on the output
 
     async def reset(self):
         d = self.dut
@@ -92,8 +95,12 @@ class Array:
             d.data_i.value = data
             await RisingEdge(d.clk_i)
             await ReadOnly()
+            self.edge += 1
+            if ident == isa.REFRESH:
+                self.refresh_edges.append(self.edge)
             if int(d.pixel_valid_o.value):
                 self.pixels.append(int(d.pixel_o.value))
+                self.pixel_edges.append(self.edge)
             if self.model:
                 self.model.step(ident, data)
                 self.history.append(self.model.packed_state())
@@ -168,6 +175,13 @@ async def directed_boundaries(dut):
     await arr.play(spaced(isa.serialise(cmds), n))
     want = functional.render(cmds, n, carry_bug=carry_bug(dut))
     np.testing.assert_array_equal(arr.frame(), want)
+    # docs/array.md: a Refresh on ident_i in the cycle ending with edge R puts column q
+    # on pixel_o after edge R + NumChips + 2 + q.
+    k = arr.k
+    for line, r in enumerate(arr.refresh_edges):
+        edges = arr.pixel_edges[line * n:(line + 1) * n]
+        assert edges == list(range(edges[0], edges[0] + n)), f"line {line}: gaps {edges}"
+        assert edges[0] - r == k + 2, f"line {line}: latency {edges[0] - r}, want {k + 2}"
 
 
 @cocotb.test()
