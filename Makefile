@@ -10,13 +10,21 @@ DE := $(VENV)/bin/diffengine
 OUT := $(ROOT)/out
 DEMO_FILE ?= sw/scenes/fig7_25.cmd
 
-.PHONY: help setup demo test test-py test-c test-rtl test-long bench clean
+TEST ?= table_7_5
+PE ?= 1
+BUG ?=
+RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
+
+.PHONY: help setup demo test test-py test-c test-rtl test-long bench clean waves lint
 
 help:
 	@echo "make demo        render the shipped default command file to out/demo.png"
 	@echo "make test        run every test (sets itself up on first use)"
 	@echo "make test-long   long random regressions (not part of make test)"
 	@echo "make bench       speed benchmarks, recorded in docs/performance.md"
+	@echo "make waves TEST=<cocotb test> [PE=p] [BUG=0|1]"
+	@echo "                 FST + GTKWave save file for one PE (docs/debugging.md)"
+	@echo "make lint        verilator -Wall and verible lint on every RTL file"
 	@echo "make setup       create .venv from scripts/requirements.txt"
 	@echo "make clean       remove build products (keeps .venv)"
 
@@ -41,6 +49,17 @@ test-c:
 
 test-rtl: $(SETUP)
 	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 .; fi
+
+# 10^7 random commands per array configuration through the RTL (hours on 2 cores).
+test-long: $(SETUP)
+	$(ENV) cd tb && N_COMMANDS=10000000 $(PY) -m pytest -q -s de_array/test_de_array_scoreboard.py
+
+waves: $(SETUP)
+	@./scripts/ensure_fst.sh
+	$(ENV) $(PY) scripts/waves.py $(TEST) --pe $(PE) $(if $(BUG),--bug $(BUG),)
+
+lint: $(SETUP)
+	$(ENV) ./scripts/lint.sh
 
 bench: $(SETUP)
 	$(ENV) $(PY) scripts/bench_model.py

@@ -164,6 +164,14 @@ def write_image(path: str, pix, bits: int, raw: bool) -> None:
     import OpenImageIO as oiio
 
     h, w = pix.shape
+    if path == "-" or path.lower().endswith(".txt"):
+        # Pixel numbers as text, one scanline per line: for reading and diffing.
+        text = "\n".join(" ".join(str(int(v)) for v in row) for row in pix) + "\n"
+        if path == "-":
+            sys.stdout.write(text)
+        else:
+            Path(path).write_text(text)
+        return
     if path.lower().endswith(".exr"):
         arr = pix.astype(np.float32) / (1 if raw else (1 << bits))
         spec = oiio.ImageSpec(w, h, 1, "float")

@@ -197,3 +197,18 @@ def test_console_script_no_traceback(tmp_path):
                        capture_output=True, text=True)
     assert p.returncode == 1
     assert p.stderr == f"{bad}:2: Eval1 I: not a number: '0.9375.0'\n"
+
+
+def test_model_text_output_table_7_5(tmp_path, capsys):
+    """`-o -` prints pixel rows: the Table 7.5 rows of docs/debugging.md."""
+    from diffengine import cli
+    src = tmp_path / "t75.cmd"
+    src.write_text("Eval3 (0, 9, 0x000.000000, 0x000.000000, 0x000.800000);\nRefresh;\n")
+    rows = {}
+    for name, extra in (("good", []), ("bad", ["--carry-bug"]),
+                        ("comp", ["--carry-bug", "--compensate"])):
+        assert cli.main(["model", str(src), "--width", "9", "-o", "-", *extra]) == 0
+        rows[name] = capsys.readouterr().out.split()
+    assert rows["good"] == "0 0 0 1 3 5 7 10 14".split()
+    assert rows["bad"] == "0 0 0 2 6 10 14 20 28".split()
+    assert rows["comp"] == "0 0 0 0 2 4 6 10 14".split()
