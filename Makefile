@@ -62,7 +62,7 @@ lint: $(SETUP)
 	$(ENV) ./scripts/lint.sh
 
 bench: $(SETUP)
-	$(ENV) $(PY) scripts/bench_model.py
+	$(ENV) $(PY) scripts/bench_model.py --write
 
 clean:
 	rm -rf $(OUT) build sim/out

@@ -22,7 +22,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "sw"))
 
-from diffengine import functional, isa  # noqa: E402
+from diffengine import functional, isa, structural  # noqa: E402
 
 ONE = 1 << isa.FRAC_BITS
 SECTION = "## Golden model (functional)"
@@ -76,6 +76,17 @@ def main(argv=None):
         sec = bench(cmds, args.repeat)
         rows.append((name, len(cmds), sec, len(cmds) / sec))
         print(f"{name:10s} {len(cmds):7d} commands  {sec:7.3f} s/frame  {len(cmds) / sec:12,.0f} commands/s")
+    # Baseline in the same run (these machines are noisy): the cycle-level structural
+    # model on the first lines of the mixed frame, extrapolated to a whole frame.
+    lines = isa.split_lines(random_frame(np.random.default_rng(args.seed), mixed=True))[:4]
+    sub = [c for line in lines for c in line]
+    t = time.perf_counter()
+    structural.render(sub, 640)
+    sec_line = (time.perf_counter() - t) / len(lines)
+    n_frame = rows[-1][1]
+    rows.append(("baseline: structural, cycle level (4 lines, x120)", n_frame, sec_line * 480,
+                 n_frame / (sec_line * 480)))
+    print(f"baseline   structural model {sec_line * 480:7.1f} s/frame (extrapolated from 4 lines)")
     if args.write:
         write_doc(rows)
 
@@ -83,16 +94,18 @@ def main(argv=None):
 def write_doc(rows):
     path = ROOT / "docs" / "performance.md"
     text = path.read_text() if path.exists() else "# Performance\n"
-    table = "\n".join(f"| {n} | {c} | {s:.3f} | {r:,.0f} |" for n, c, s, r in rows)
+    base = rows[-1][2]
+    table = "\n".join(f"| {n} | {c} | {s:.3f} | {r:,.0f} | {base / s:,.0f}x |" for n, c, s, r in rows)
     body = f"""{SECTION}
 
 `functional.render()` on a random 640x480 frame, ~100 commands per line (Eval1/2/3 spans
 of 5-60 px; "mixed" adds ~3 Set/SetP/Dis/Eval0 per line, which sends every line through
-the per-command path instead of the batched Eval1-3 frame path). Best of 3, one core,
+the per-command path instead of the batched Eval1-3 frame path). The baseline, measured in
+the same run, is the cycle-level structural model on the mixed frame. Best of 3, one core,
 {platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}, {platform.machine()}.
 
-| frame | commands | s/frame | commands/s |
-|---|---|---|---|
+| frame | commands | s/frame | commands/s | speed vs baseline |
+|---|---|---|---|---|
 {table}
 
 Reproduce: `.venv/bin/python scripts/bench_model.py --write`
