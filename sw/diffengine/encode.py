@@ -303,20 +303,25 @@ def image_psnr(results: list[Result], x: np.ndarray) -> float:
 # ---- RTL hook -------------------------------------------------------------------------------
 
 
-def rtl_bit_identity(commands, width: int) -> tuple[bool, str]:
-    """Decode `commands` with the hardware path and compare with the golden model.
+def rtl_bit_identity(commands, width: int, rtl: bool = False) -> tuple[bool, str]:
+    """Decode `commands` with a hardware path and compare with the golden model.
 
-    The Verilated array is not wired up yet (RTL path pending); until it is, the
-    slot-level structural model (`structural.render`, the reference for how the
-    hardware computes) stands in. Returns (identical, which path ran).
+    rtl=True plays them through the Verilated array (sim/harness, ceil(width/9) chips;
+    columns past `width` are ignored: relative addressing makes a PE's result depend only
+    on its own column). Otherwise the cycle-level structural model stands in, which keeps
+    the Python unit tests free of Verilator builds. Returns (identical, which path ran).
     """
     gold = functional.render(commands, width)
-    try:
-        from . import structural
-    except ImportError:  # pragma: no cover - structural.py not present
-        return True, "none (structural model missing; RTL pending)"
+    if rtl:
+        from . import harness
+
+        chips = -(-width // 9)
+        hw, _ = harness.run(commands, chips)
+        return bool(np.array_equal(hw[:, :width], gold)), f"Verilated array, {chips} chips"
+    from . import structural
+
     hw = structural.render(commands, width)
-    return bool(np.array_equal(hw, gold)), "structural (RTL pending)"
+    return bool(np.array_equal(hw, gold)), "structural model"
 
 
 # ---- files ------------------------------------------------------------------------------------

@@ -126,9 +126,9 @@ def test_jpeg_matched_bytes(natural):
     assert size <= 3000 and 1 <= q <= 100 and dec.shape == natural.shape
 
 
-def test_rtl_vs_model_bit_identity_hook():
-    """RTL-vs-model bit identity of a decoded image. The Verilated array is pending;
-    `rtl_bit_identity` runs the structural (slot-level) model in its place."""
+def test_structural_vs_model_bit_identity():
+    """Cycle-level model vs golden model on a decoded image (the Verilated array's run
+    is tb/recon/test_recon_rtl.py)."""
     x = crop("natural", rows=3, cols=24)
     res = EN.ChannelEncoder(x).encode("spline2", psnr=40.0)
     ok, path = EN.rtl_bit_identity(res.commands, x.shape[1])
