@@ -326,10 +326,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("capacity", help="print the capacity model report (Table 7.3)")
     s.set_defaults(func=cmd_capacity)
+    # Listed for --help only; main() hands `encode` to diffengine.encode.encode_main.
+    sub.add_parser("encode", help="image -> multiresolution spline command file "
+                   "(diffengine encode -h)")
     return p
 
 
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["encode"]:  # its own argument parser (diffengine.encode)
+        from .encode import encode_main
+        return encode_main(argv[1:])
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)

@@ -212,3 +212,9 @@ def test_model_text_output_table_7_5(tmp_path, capsys):
     assert rows["good"] == "0 0 0 1 3 5 7 10 14".split()
     assert rows["bad"] == "0 0 0 2 6 10 14 20 28".split()
     assert rows["comp"] == "0 0 0 0 2 4 6 10 14".split()
+
+
+def test_encode_subcommand_is_wired(tmp_path):
+    from diffengine import cli
+    out = tmp_path / "r.cmd"
+    assert cli.main(["encode", "/no/such/image.png", "-o", str(out)]) != 0
