@@ -16,12 +16,21 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def build(chips: int, carry_bug: bool = False, threads: int = 1) -> Path:
-    """Build (or reuse) the harness for `chips` chips; returns the executable."""
-    env = dict(os.environ)
-    subprocess.run(["make", "-s", "-C", str(REPO / "sim"), "harness", f"CHIPS={chips}",
-                    f"CARRY_BUG={int(carry_bug)}", f"THREADS={threads}"],
-                   check=True, env=env, stdout=subprocess.DEVNULL)
-    return REPO / "sim" / "build" / f"array_c{chips}_b{int(carry_bug)}_t{threads}" / "Vde_array"
+    """Build (or reuse) the harness for `chips` chips; returns the executable.
+
+    A lock file per configuration serialises concurrent callers (pytest-xdist workers
+    that need the same build), so make never runs twice in one build folder."""
+    import fcntl
+
+    tag = f"array_c{chips}_b{int(carry_bug)}_t{threads}"
+    lock_dir = REPO / "sim" / "build"
+    lock_dir.mkdir(parents=True, exist_ok=True)
+    with open(lock_dir / f".{tag}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        subprocess.run(["make", "-s", "-C", str(REPO / "sim"), "harness", f"CHIPS={chips}",
+                        f"CARRY_BUG={int(carry_bug)}", f"THREADS={threads}"],
+                       check=True, env=dict(os.environ), stdout=subprocess.DEVNULL)
+    return REPO / "sim" / "build" / tag / "Vde_array"
 
 
 def read_depx(path: Path) -> np.ndarray:
