@@ -1,0 +1,472 @@
+"""End-to-end cocotb tests for rtl/ctrl/display_controller.sv (full colour).
+
+K y-processors per colour write random command streams (sw/diffengine randgen, one
+stream per y-processor and colour, a marker after every line) through the write ports
+with random stalls; the controller runs the small test video mode with arrays of one or
+two chips. Checks:
+
+* bus legality per colour: every word on an instruction bus comes from the buffer that
+  holds the grant, commands are contiguous and whole (a command may only be cut by the
+  Refresh), and what a buffer issues in the window of active line n is a prefix of its
+  y-processor's line n (all of it when the buffer was done, i.e. not late);
+* pixels: the RGB output sampled where blank is low equals, bit for bit,
+  functional.render() of the complete commands issued in each line's window, in issue
+  order (the interleaving of K y-processors is decided by the arbiter, so it is taken
+  from the bus; its legality is the check above); the 8-bit window likewise;
+* alignment: blank low exactly while the arrays show columns 0..HActive-1 (array
+  pixel_valid one output register earlier), hsync/vsync at their exact offsets,
+  align_err_o never set;
+* Load Monitor read-out (host port, all three channels): every line record, the frame
+  snapshot, the histogram and the totals equal what was observed on the buses, and
+  TOTAL_DROPPED equals the words the y-processors wrote that never reached a bus.
+
+test_frame_underload asserts that no line was late; test_frame_overload has lines that
+need up to ~3x the window and asserts late lines and discards. Both print the bus
+utilisation (non-Nop slots / window slots of active lines). SEED=<n> replays.
+"""
+from __future__ import annotations
+
+import os
+import random
+import sys
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+sys.path.insert(0, str(HERE.parent.parent / "sw"))
+
+from diffengine import functional, isa, randgen  # noqa: E402
+
+NCH = 3
+REFRESH_ID = 0x100
+MASK48 = (1 << 48) - 1
+
+
+def geom(dut):
+    g = {k: int(getattr(dut, k).value) for k in (
+        "TestHActive", "TestHFp", "TestHSync", "TestHBp",
+        "TestVActive", "TestVFp", "TestVSync", "TestVBp", "NumBuf", "NumChips",
+        "CarryBug", "BufDepth")}
+    g["HTotal"] = g["TestHActive"] + g["TestHFp"] + g["TestHSync"] + g["TestHBp"]
+    g["VTotal"] = g["TestVActive"] + g["TestVFp"] + g["TestVSync"] + g["TestVBp"]
+    g["n_pe"] = 9 * g["NumChips"]
+    return g
+
+
+def words_of(cmds) -> list[int]:
+    return [(i << 36) | d for i, d in isa.serialise(cmds)]
+
+
+def is_start(w: int) -> bool:
+    return ((w >> 45) & 3) == 0
+
+
+def make_streams(seed: int, g: dict, n_lines: int, per_line, max_words: int | None):
+    """streams[c][i] = list of n_lines lines, each a list of commands (no Refresh)."""
+    streams = []
+    for c in range(NCH):
+        chan = []
+        for i in range(g["NumBuf"]):
+            lines = []
+            rng = random.Random(seed * 131 + c * 17 + i)
+            while len(lines) < n_lines:
+                ln = [cm for cm in randgen.stream(rng.randrange(1 << 30), 1, g["n_pe"],
+                                                  per_line) if cm.op != "REFRESH"]
+                if max_words is not None:
+                    while ln and len(words_of(ln)) > max_words:
+                        ln.pop()
+                lines.append(ln)
+            chan.append(lines)
+        streams.append(chan)
+    return streams
+
+
+class Bench:
+    def __init__(self, dut, g, streams, stall_p, seed):
+        self.dut, self.g, self.streams = dut, g, streams
+        self.rng = random.Random(seed)
+        self.stall_p = stall_p
+        nb = g["NumBuf"]
+        self.nb = nb
+        # Word queues per port: every line's words followed by its marker.
+        self.queues = []
+        for c in range(NCH):
+            for i in range(nb):
+                q = []
+                for ln in streams[c][i]:
+                    q += words_of(ln) + [REFRESH_ID << 36]
+                self.queues.append(q)
+        self.pos = [0] * (NCH * nb)
+        self.cur = [None] * (NCH * nb)   # word being offered (valid held until taken)
+        self.samples = []
+        self.stop = False
+
+    async def drive(self):
+        dut, nb = self.dut, self.nb
+        while not self.stop:
+            await FallingEdge(dut.clk_i)
+            ready = int(dut.wr_ready_o.value)
+            valid = 0
+            data = 0
+            for p in range(NCH * nb):
+                if self.cur[p] is None and self.pos[p] < len(self.queues[p]) and \
+                        self.rng.random() >= self.stall_p:
+                    self.cur[p] = self.queues[p][self.pos[p]]
+                    self.pos[p] += 1
+                if self.cur[p] is not None:
+                    valid |= 1 << p
+                    data |= self.cur[p] << (48 * p)
+                    if (ready >> p) & 1:   # ready depends on registers only
+                        self.cur[p] = None
+            dut.wr_valid_i.value = valid
+            dut.wr_data_i.value = data
+
+    def all_written(self) -> bool:
+        return all(self.pos[p] == len(self.queues[p]) and self.cur[p] is None
+                   for p in range(NCH * self.nb))
+
+    async def monitor(self):
+        dut = self.dut
+        core = dut.u_core
+        grants = [core.g_ch[c].u_ac.grant_o for c in range(NCH)]
+        drops = [core.g_ch[c].u_ac.drop_o for c in range(NCH)]
+        while True:
+            await RisingEdge(dut.clk_i)
+            await ReadOnly()
+            self.samples.append(dict(
+                instr=int(core.instr_o.value),
+                grant=[int(x.value) for x in grants],
+                drop=[int(x.value) for x in drops],
+                done=int(dut.done_o.value),
+                pv=int(core.pix_valid_i.value),
+                rgb=int(dut.rgb_o.value),
+                rgb8=int(dut.rgb8_o.value),
+                blank=int(dut.blank_o.value),
+                hs=int(dut.hsync_o.value),
+                vs=int(dut.vsync_o.value),
+                err=int(dut.align_err_o.value),
+            ))
+
+
+async def read_reg(dut, addr: int) -> int:
+    """One register read per clock; call right after a falling edge."""
+    dut.reg_addr_i.value = addr
+    await RisingEdge(dut.clk_i)       # address sampled
+    await FallingEdge(dut.clk_i)      # data valid one clock later
+    return int(dut.reg_rdata_o.value)
+
+
+def analyse_bus(bench):
+    """Per channel: the windows of active lines (in order), each with the words issued per
+    buffer, the complete commands in issue order, free/issued counts and late buffers."""
+    g, nb = bench.g, bench.nb
+    out = []
+    for c in range(NCH):
+        wins = []
+        k = 0                    # Refresh counter
+        cur = dict(words=[], per_buf=[[] for _ in range(nb)], order=[], nops=0)
+        prev_owner = None        # buffer of the previous slot's word (None: Nop/Refresh)
+        for t, s in enumerate(bench.samples):
+            w = (s["instr"] >> (48 * c)) & MASK48
+            gr = s["grant"][c]
+            if (w >> 36) == REFRESH_ID:
+                assert gr == 0, f"ch{c} t={t}: Refresh with a grant"
+                # Refresh k is the one of line VActive + k (reset starts in the blank).
+                v = (g["TestVActive"] + k) % g["VTotal"]
+                if v < g["TestVActive"]:
+                    done = (bench.samples[t - 1]["done"] >> (c * nb)) & ((1 << nb) - 1)
+                    cur["late"] = [not (done >> i) & 1 for i in range(nb)]
+                    cur["line"] = v
+                    cur["t"] = t
+                    wins.append(cur)
+                else:
+                    assert not cur["words"], f"ch{c}: words in a blank line's window"
+                k += 1
+                cur = dict(words=[], per_buf=[[] for _ in range(nb)], order=[], nops=0)
+                prev_owner = None
+                continue
+            if gr == 0:
+                assert w == 0, f"ch{c} t={t}: non-Nop {w:012x} without a grant"
+                cur["nops"] += 1
+                prev_owner = None
+                continue
+            assert gr & (gr - 1) == 0, f"ch{c} t={t}: grant {gr:b} not one-hot"
+            i = gr.bit_length() - 1
+            if not is_start(w):
+                assert prev_owner == i, f"ch{c} t={t}: continuation slot not contiguous"
+            cur["words"].append(w)
+            cur["per_buf"][i].append(w)
+            cur["order"].append((i, w))
+            prev_owner = i
+        out.append(wins)
+    return out
+
+
+def commands_in_order(bench, c, n, win):
+    """Complete commands of window n in issue order; checks prefixes of the y-lines."""
+    nb = bench.nb
+    # Split each buffer's issued words into its line's commands.
+    expect_cmds = [bench.streams[c][i][n] if n < len(bench.streams[c][i]) else []
+                   for i in range(nb)]
+    slot_lists = [[words_of([cm]) for cm in expect_cmds[i]] for i in range(nb)]
+    for i in range(nb):
+        full = [w for sl in slot_lists[i] for w in sl]
+        got = win["per_buf"][i]
+        assert got == full[:len(got)], f"ch{c} line {n} buf {i}: not a prefix of its line"
+        if not win["late"][i]:
+            assert got == full, f"ch{c} line {n} buf {i}: done but incomplete"
+    # Walk the issue order, consuming whole commands per buffer.
+    idx = [0] * nb       # next command per buffer
+    fill = [0] * nb      # slots of that command already seen
+    order = []
+    for i, _w in win["order"]:
+        fill[i] += 1
+        if fill[i] == len(slot_lists[i][idx[i]]):
+            order.append(expect_cmds[i][idx[i]])
+            idx[i] += 1
+            fill[i] = 0
+    return order
+
+
+def expected_frame(bench, wins):
+    """golden[c] = rows of HActive pixels, one per active window, from the model."""
+    g = bench.g
+    gold = []
+    for c in range(NCH):
+        rows = []
+        for n, win in enumerate(wins[c]):
+            cmds = commands_in_order(bench, c, n, win) + [isa.Command("REFRESH")]
+            rows.append(functional.render(cmds, g["n_pe"], carry_bug=bool(g["CarryBug"]))
+                        [0][:g["TestHActive"]])
+        gold.append(np.array(rows, dtype=np.int64))
+    return gold
+
+
+def out8(p: int, w: int, sat: bool) -> int:
+    sh = p >> w
+    if not sat:
+        return sh & 0xFF
+    if p >> 11:
+        return 0
+    return 0xFF if sh > 0xFF else sh
+
+
+def check_video(bench, gold, w8, sat8):
+    g = bench.g
+    S = bench.samples
+    ha, ht = g["TestHActive"], g["HTotal"]
+    rows = [[] for _ in range(NCH)]
+    rises = []
+    for t, s in enumerate(S):
+        assert s["err"] == 0, f"t={t}: align_err_o set"
+        if s["blank"] == 0:
+            # The output register holds what the arrays showed one cycle earlier.
+            assert S[t - 1]["pv"] == 0b111, f"t={t}: blank low but no pixel from an array"
+            if S[t - 1]["blank"] == 1:
+                rises.append(t)
+                assert S[t - 2]["pv"] == 0, f"t={t}: blank falls after column 0"
+                for c in range(NCH):
+                    rows[c].append([])
+            for c in range(NCH):
+                p = (s["rgb"] >> (12 * c)) & 0xFFF
+                rows[c][-1].append(p)
+                assert ((s["rgb8"] >> (8 * c)) & 0xFF) == out8(p, w8, sat8), \
+                    f"t={t}: 8-bit window"
+        else:
+            assert s["rgb"] == 0 and s["rgb8"] == 0, f"t={t}: pixel data while blank"
+    if S[-1]["blank"] == 0:           # the simulation ended inside a line
+        for c in range(NCH):
+            rows[c].pop()
+    for c in range(NCH):
+        assert all(len(r) == ha for r in rows[c]), \
+            f"active lines of the wrong length: {[len(r) for r in rows[c]]}"
+    n = min(len(rows[0]), len(gold[0]))
+    assert n >= g["TestVActive"] * 2, f"only {n} lines compared"
+    for c in range(NCH):
+        got = np.array(rows[c][:n], dtype=np.int64)
+        bad = np.argwhere(got != gold[c][:n])
+        assert bad.size == 0, (f"colour {c}: {len(bad)} pixels differ, first at line/col "
+                               f"{bad[0]}: got {got[tuple(bad[0])]} want "
+                               f"{gold[c][tuple(bad[0])]}")
+    # Sync: active low in the test mode, at exact offsets from the line start.
+    for t0 in rises:
+        for dt in range(ht):
+            if t0 + dt >= len(S):
+                break
+            hs_on = ha + g["TestHFp"] <= dt < ha + g["TestHFp"] + g["TestHSync"]
+            assert S[t0 + dt]["hs"] == (0 if hs_on else 1), f"hsync at line start+{dt}"
+    # Line starts are HTotal apart; vsync starts VFp+1 lines after the last active line
+    # of a frame and lasts VSync lines.
+    va = g["TestVActive"]
+    for f in range(len(rises) // va):
+        last = rises[(f + 1) * va - 1]
+        vs0 = last + (g["TestVFp"] + 1) * ht
+        for t in range(last, min(vs0 + (g["TestVSync"] + 1) * ht, len(S))):
+            want = 0 if vs0 <= t < vs0 + g["TestVSync"] * ht else 1
+            assert S[t]["vs"] == want, f"vsync at t={t}"
+    for a, b in zip(rises, rises[1:]):
+        assert b - a == ht or b - a == ht * (g["VTotal"] - va + 1)
+    return n
+
+
+async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overload):
+    seed = int(os.environ.get("SEED", random.randrange(1 << 30)))
+    dut._log.info(f"SEED={seed}")
+    g = geom(dut)
+    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
+    n_lines = frames * g["TestVActive"]
+    streams = make_streams(seed, g, n_lines, per_line, max_words)
+    bench = Bench(dut, g, streams, stall_p, seed)
+    dut.rst_i.value = 1
+    dut.mode_i.value = 3
+    dut.wr_valid_i.value = 0
+    dut.wr_data_i.value = 0
+    dut.reg_addr_i.value = 0
+    dut.out8_shift_i.value = w8
+    dut.out8_sat_i.value = int(sat8)
+    dut.cfg_mode_i.value = 0
+    dut.cfg_bit_i.value = 0
+    dut.obs_load_i.value = 0
+    dut.obs_shift_i.value = 0
+    await ClockCycles(dut.clk_i, 3)
+    await FallingEdge(dut.clk_i)
+    dut.rst_i.value = 0
+    cocotb.start_soon(bench.monitor())
+    cocotb.start_soon(bench.drive())
+    ht, vt, va = g["HTotal"], g["VTotal"], g["TestVActive"]
+    # The last active line of the last frame is refreshed (vt - va) + frames*vt - 1 lines
+    # after reset (h = 0 of the first vertical-blank line).
+    last_refresh = ((vt - va) + (frames - 1) * vt + va - 1) * ht + 1
+    await ClockCycles(dut.clk_i, last_refresh + 2)
+    await FallingEdge(dut.clk_i)
+    # Snapshot and line table of the last frame: stable through its vertical blank.
+    regs = {}
+    for c in range(NCH):      # the line table first: line 0 is rewritten after the blank
+        for ln in range(va):
+            regs[(c, 0x400 + ln)] = await read_reg(dut, (c << 12) | 0x400 + ln)
+    for c in range(NCH):
+        base = c << 12
+        for a in [0x0, 0x1, 0x2, 0x3, 0x4, 0x5, 0x6, 0x7, 0x8]:
+            regs[(c, a)] = await read_reg(dut, base | a)
+        for b in range(int(dut.NumBins.value)):
+            regs[(c, 0x40 + b)] = await read_reg(dut, base | 0x40 + b)
+    info = await read_reg(dut, 3 << 12)
+    # Let every late line drain before the totals are read.
+    for _ in range(40):
+        await ClockCycles(dut.clk_i, ht)
+        if bench.all_written():
+            break
+    await ClockCycles(dut.clk_i, 2 * ht)
+    await FallingEdge(dut.clk_i)
+    assert bench.all_written(), "y-processors could not write everything"
+    tot, t_read = {}, {}
+    for c in range(NCH):
+        tot[(c, 9)] = await read_reg(dut, (c << 12) | 0x9)
+        t_read[c] = len(bench.samples)
+        tot[(c, 10)] = await read_reg(dut, (c << 12) | 0xA)
+    bench.stop = True
+    all_wins = analyse_bus(bench)
+    # The windows whose lines belong to the streams.
+    wins = [w[:n_lines] for w in all_wins]
+    gold = expected_frame(bench, wins)
+    n = check_video(bench, gold, w8, sat8)
+
+    # ---- Load Monitor read-out vs the buses ---------------------------------------
+    assert info == (0xDC << 24) | (3 << 20) | (g["NumBuf"] << 16) | (g["NumChips"] + 3)
+    nbins, shift = int(dut.NumBins.value), int(dut.BinShift.value)
+    util = []
+    total_late_lines = 0
+    for c in range(NCH):
+        ws = wins[c]
+        assert len(ws) == n_lines
+        frame = ws[-va:]
+        assert regs[(c, 0)] == (0xDE << 24) | (nbins << 16) | (shift << 12) | \
+            (g["NumBuf"] << 8) | 1
+        assert regs[(c, 1)] == frames, f"ch{c}: FRAME_COUNT"
+        issued = [len(w["words"]) for w in frame]
+        free = [w["nops"] for w in frame]
+        late = [sum(w["late"]) for w in frame]
+        for w in ws:
+            assert len(w["words"]) + w["nops"] == ht - 1, "window length"
+        assert regs[(c, 2)] == sum(issued), f"ch{c}: SNAP_ISSUED"
+        assert regs[(c, 3)] == sum(free), f"ch{c}: SNAP_FREE"
+        assert regs[(c, 4)] == sum(1 for x in late if x), f"ch{c}: SNAP_LATE_LINES"
+        assert regs[(c, 6)] == max(issued), f"ch{c}: SNAP_MAX_ISSUED"
+        assert regs[(c, 7)] == va - 1, f"ch{c}: LAST_LINE"
+        hist = [0] * nbins
+        for x in issued:
+            hist[min(x >> shift, nbins - 1)] += 1
+        assert [regs[(c, 0x40 + b)] for b in range(nbins)] == hist, f"ch{c}: histogram"
+        for ln in range(va):
+            rec = (int(late[ln] > 0) << 31) | (late[ln] << 24) | (free[ln] << 12) | issued[ln]
+            assert regs[(c, 0x400 + ln)] == rec, f"ch{c}: LINE[{ln}] record"
+        assert regs[(c, 8)] == regs[(c, 0x400 + va - 1)], f"ch{c}: LAST_REC"
+        # Discards: every word a y-processor wrote for a line but that never reached
+        # the bus (markers excluded).
+        dropped = 0
+        for n_, w in enumerate(ws):
+            for i in range(g["NumBuf"]):
+                dropped += len(words_of(bench.streams[c][i][n_])) - len(w["per_buf"][i])
+        assert tot[(c, 9)] == dropped, f"ch{c}: TOTAL_DROPPED {tot[(c, 9)]} != {dropped}"
+        # Late lines up to the read, including any after the streams ended.
+        lates = sum(1 for w in all_wins[c] if w["t"] < t_read[c] and any(w["late"]))
+        assert tot[(c, 10)] == lates, f"ch{c}: TOTAL_LATE_LINES"
+        total_late_lines += sum(1 for w in ws if any(w["late"]))
+        util.append(sum(len(w["words"]) for w in ws) / (len(ws) * (ht - 1)))
+    dut._log.info(f"{n} lines x 3 colours bit-exact; bus utilisation (active windows) "
+                  f"R/G/B = {', '.join(f'{u:.3f}' for u in util)}; late lines "
+                  f"{total_late_lines}; dropped words "
+                  f"{[tot[(c, 9)] for c in range(NCH)]}")
+    if overload:
+        assert total_late_lines > 0 and sum(tot[(c, 9)] for c in range(NCH)) > 0
+    else:
+        assert total_late_lines == 0, "underload test had a late line"
+    return util
+
+
+@cocotb.test()
+async def test_frame_underload(dut):
+    """No line exceeds its window: every command of every y-processor is shown."""
+    g = geom(dut)
+    per_y = (g["HTotal"] - 1) // g["NumBuf"] - 1
+    await run_frames(dut, stall_p=0.25, per_line=(0, 3), max_words=per_y, frames=6,
+                     w8=2, sat8=True, overload=False)
+
+
+@cocotb.test()
+async def test_frame_overload(dut):
+    """Lines of up to ~3x the window: late lines, discards, exact read-out."""
+    await run_frames(dut, stall_p=0.1, per_line=(0, 7), max_words=None, frames=6,
+                     w8=4, sat8=False, overload=True)
+
+
+# ---- pytest runner: one build folder per parameter set -------------------------------
+
+RUNS = {
+    # 2 chips = 18 PEs >= HActive 16; line 24 slots, frame 11 lines.
+    "chips2_bug0": dict(NumChips=2, CarryBug=0, NumBuf=2, BufDepth=32, NumBins=4,
+                        BinShift=3, MaxLines=8),
+    # 1 chip = 9 PEs: HActive 9, line 17 slots; the carry bug in all three arrays.
+    "chips1_bug1": dict(NumChips=1, CarryBug=1, NumBuf=3, BufDepth=16, NumBins=4,
+                        BinShift=2, MaxLines=8, TestHActive=9, TestHFp=2, TestHSync=3,
+                        TestHBp=3),
+}
+
+
+@pytest.mark.parametrize("name", list(RUNS))
+def test_display_controller(name):
+    from common.run import RTL, build_and_test
+    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
+            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
+            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv",
+            RTL / "ctrl" / "de_instr_buffer.sv", RTL / "ctrl" / "de_video_timing.sv",
+            RTL / "ctrl" / "de_access_ctrl.sv", RTL / "ctrl" / "de_load_monitor.sv",
+            RTL / "ctrl" / "de_display_core.sv", RTL / "ctrl" / "display_controller.sv"]
+    build_and_test(HERE, "display_controller", srcs, "test_display_controller",
+                   parameters=RUNS[name])
