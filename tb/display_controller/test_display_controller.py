@@ -196,7 +196,12 @@ def analyse_bus(bench):
     buffer, the complete commands in issue order, free/issued counts and late buffers."""
     g, nb = bench.g, bench.nb
     out = []
+    refresh_at = []
     for c in range(NCH):
+        refresh_at.append([t for t, s in enumerate(bench.samples)
+                           if ((s["instr"] >> (48 * c + 36)) & 0xFFF) == REFRESH_ID])
+        assert refresh_at[c] == refresh_at[0], "colour channels out of lockstep"
+        assert all(b - a == g["HTotal"] for a, b in zip(refresh_at[c], refresh_at[c][1:]))
         wins = []
         k = 0                    # Refresh counter
         cur = dict(words=[], per_buf=[[] for _ in range(nb)], order=[], nops=0)
