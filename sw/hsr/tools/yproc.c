@@ -1,5 +1,6 @@
 /* yproc - command-line front end of sw/hsr.
- *   yproc hsr SCENE [--dump-llr FILE.json] [--svg FILE.svg] [--stats]
+ *   yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]
+ *                   [--svg FILE.svg] [--stats]
  * Reads the scene (and its OBJ files), applies viewing and perspective,
  * runs the exact incremental HSR and writes the requested outputs.
  * Errors are printed as "file:line: message"; the exit status is 1. */
@@ -10,17 +11,53 @@
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: yproc hsr SCENE [--dump-llr FILE.json] [--svg FILE.svg] [--stats]\n");
+    fprintf(stderr, "usage: yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]"
+                    " [--svg FILE.svg] [--stats]\n");
     return 2;
+}
+
+/* --dump-input: every MLR domain (the projected, clipped, quantised input
+ * faces) with id, opacity, plane and rings, pixel coordinates, y down
+ * (schema "hsr-input-1" in docs/hsr.md; used by sw/tests/test_hsr_oracle.py). */
+static hsr_status write_input_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return HSR_EIO;
+    const double S = HSR_SUBPIXEL;
+    hsr_status st = HSR_OK;
+    fprintf(f, "{\"format\": \"hsr-input-1\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
+               " \"mlr_count\": %d, \"polygons\": [", HSR_SUBPIXEL, sc->width, sc->height, hsr_mlr_slots(h));
+    for (int id = 0; id < hsr_mlr_slots(h) && st == HSR_OK; id++) {
+        const hsr_domain *d; hsr_plane pl; double op;
+        if (!hsr_mlr_get(h, id, &d, &pl, &op, NULL, NULL)) continue;
+        double *xy = NULL; int *len = NULL, nr = 0;
+        st = hsr_domain_rings(d, &xy, &len, &nr);
+        if (st != HSR_OK) break;
+        fprintf(f, "%s\n  {\"id\": %d, \"opacity\": %.17g, \"area_px2\": %.17g,"
+                   " \"plane\": [%.17g, %.17g, %.17g],\n   \"rings\": [",
+                id ? "," : "", id, op, hsr_domain_area(d) / (S * S), pl.a * S, pl.b * S, pl.c);
+        for (int r = 0, off = 0; r < nr; off += len[r], r++) {
+            fprintf(f, "%s[", r ? ", " : "");
+            for (int i = 0; i < len[r]; i++)
+                fprintf(f, "%s[%.17g, %.17g]", i ? ", " : "", xy[2 * (off + i)] / S, xy[2 * (off + i) + 1] / S);
+            fprintf(f, "]");
+        }
+        fprintf(f, "]}");
+        free(xy); free(len);
+    }
+    fprintf(f, "\n]}\n");
+    if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
+    return st;
 }
 
 int main(int argc, char **argv)
 {
     if (argc < 3 || strcmp(argv[1], "hsr")) return usage();
-    const char *scene = argv[2], *json = NULL, *svg = NULL;
+    const char *scene = argv[2], *json = NULL, *svg = NULL, *input = NULL;
     int stats = 0;
     for (int i = 3; i < argc; i++) {
         if (!strcmp(argv[i], "--dump-llr") && i + 1 < argc) json = argv[++i];
+        else if (!strcmp(argv[i], "--dump-input") && i + 1 < argc) input = argv[++i];
         else if (!strcmp(argv[i], "--svg") && i + 1 < argc) svg = argv[++i];
         else if (!strcmp(argv[i], "--stats")) stats = 1;
         else return usage();
@@ -40,6 +77,9 @@ int main(int argc, char **argv)
     int rc = 0;
     if (json && (st = hsr_write_llr_json(json, h, sc)) != HSR_OK) {
         fprintf(stderr, "%s: cannot write (%s)\n", json, hsr_status_str(st)); rc = 1;
+    }
+    if (input && (st = write_input_json(input, h, sc)) != HSR_OK) {
+        fprintf(stderr, "%s: cannot write (%s)\n", input, hsr_status_str(st)); rc = 1;
     }
     if (svg && (st = hsr_write_svg(svg, h, sc, shade)) != HSR_OK) {
         fprintf(stderr, "%s: cannot write (%s)\n", svg, hsr_status_str(st)); rc = 1;
