@@ -1,0 +1,302 @@
+/* hsr_bench - benchmark entry points of sw/hsr (driven by scripts/bench_hsr.py).
+ *
+ *   hsr_bench grid EXTENTS W SIZE NQ N1 [N2 ...]
+ *       EXTENTS: text file, one "left bot right top" (integers) per line,
+ *       window [0,W]x[0,W].  For every subdivision N an N x N Grid-List over
+ *       the window is filled, then NQ x NQ query extents of SIZE x SIZE are
+ *       placed on a regular grid of positions covering the window.  Prints per
+ *       N: "grid N entries E empty_cells C overlaps O": list entries visited
+ *       (hsr_gridlist_query's count, including the entry that stops a list),
+ *       empty cells addressed (counted as memory accesses, as footnote 10 of
+ *       section 5.3.3 does) and extents actually overlapping, summed over all
+ *       queries.
+ *   hsr_bench hsr SCENE [REPEAT]
+ *       Builds the scene (projection + incremental HSR of every face, in
+ *       order) REPEAT times; prints faces, visible domains, best seconds.
+ *   hsr_bench stack steps|spets N [REPEAT] [reverse]
+ *       N nested triangles (0,0),(s,0),(0,s), s = 2^18 (N-i)/N units,
+ *       tri-steps: smaller ones nearer (all visible), tri-spets: larger ones
+ *       nearer (one visible); added in order (or reversed).  Prints
+ *       triangles, visible domains, best seconds.
+ *   hsr_bench move SCENE_A SCENE_B K [REPEAT]
+ *       SCENE_A and SCENE_B differ only in the last K faces (a small object
+ *       moved).  Times the full build of A, hsr_rebuild of A, and the
+ *       incremental move of those K faces to their B geometry (hsr_move per
+ *       face) and back; checks after the move that every MLR id's visible
+ *       area equals that of a full build of B (1e-9 relative) and that
+ *       hsr_check passes.  Prints the times and "check ok" or the mismatch.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "hsr.h"
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: hsr_bench grid EXTENTS W SIZE NQ N1 [N2 ...]\n"
+                    "       hsr_bench hsr SCENE [REPEAT]\n"
+                    "       hsr_bench stack steps|spets N [REPEAT] [reverse]\n"
+                    "       hsr_bench move SCENE_A SCENE_B K [REPEAT]\n");
+    return 2;
+}
+
+static void count_cb(int id, void *ctx) { (void)id; (*(long *)ctx)++; }
+
+/* ---- grid: Table 5.2 ------------------------------------------------ */
+static int cmd_grid(int argc, char **argv)
+{
+    if (argc < 7) return usage();
+    FILE *f = fopen(argv[2], "r");
+    if (!f) { perror(argv[2]); return 1; }
+    int64_t W = atoll(argv[3]), Q = atoll(argv[4]);
+    int nq = atoi(argv[5]);
+    int n = 0, cap = 1024;
+    hsr_extent *e = malloc(sizeof *e * (size_t)cap);
+    long long l, b, r, t;
+    while (fscanf(f, "%lld %lld %lld %lld", &l, &b, &r, &t) == 4) {
+        if (n == cap) { cap *= 2; e = realloc(e, sizeof *e * (size_t)cap); }
+        if (!e) { fclose(f); return 1; }
+        e[n++] = (hsr_extent){l, b, r, t};
+    }
+    fclose(f);
+    int64_t wmax = 0, hmax = 0;
+    for (int i = 0; i < n; i++) {
+        if (e[i].right - e[i].left > wmax) wmax = e[i].right - e[i].left;
+        if (e[i].top - e[i].bot > hmax) hmax = e[i].top - e[i].bot;
+    }
+    hsr_extent win = {0, 0, W, W};
+    for (int a = 6; a < argc; a++) {
+        int m = atoi(argv[a]);
+        hsr_gridlist *g;
+        if (hsr_gridlist_create(win, m, m, &g) != HSR_OK) { fprintf(stderr, "bad grid %d\n", m); return 1; }
+        /* cell occupancy, same cell rule as gridlist.c (cell of (left, bot)) */
+        int64_t cw = (W + m - 1) / m, ch = cw;
+        int *occ = calloc((size_t)m * (size_t)m, sizeof(int));
+#define COL(x) ((x) < 0 ? 0 : ((x) / cw >= m ? m - 1 : (int)((x) / cw)))
+#define ROW(y) ((y) < 0 ? 0 : ((y) / ch >= m ? m - 1 : (int)((y) / ch)))
+        for (int i = 0; i < n; i++) {
+            if (hsr_gridlist_insert(g, i, e[i]) != HSR_OK) { fprintf(stderr, "insert failed\n"); return 1; }
+            occ[ROW(e[i].bot) * m + COL(e[i].left)]++;
+        }
+        long long entries = 0, empty = 0, over = 0;
+        double t0 = now();
+        for (int qy = 0; qy < nq; qy++)
+            for (int qx = 0; qx < nq; qx++) {
+                int64_t cx = (int64_t)((qx + 0.5) * (double)W / nq), cy = (int64_t)((qy + 0.5) * (double)W / nq);
+                hsr_extent q = {cx - Q / 2, cy - Q / 2, cx - Q / 2 + Q, cy - Q / 2 + Q};
+                long hits = 0;
+                entries += hsr_gridlist_query(g, q, count_cb, &hits);
+                over += hits;
+                int c0 = COL(q.left - wmax), c1 = COL(q.right), r0 = ROW(q.bot - hmax), r1 = ROW(q.top);
+                for (int rr = r0; rr <= r1; rr++)
+                    for (int cc = c0; cc <= c1; cc++) empty += occ[rr * m + cc] == 0;
+            }
+        double dt = now() - t0;
+        printf("grid %d entries %lld empty_cells %lld overlaps %lld queries %d seconds %.6f\n",
+               m, entries, empty, over, nq * nq, dt);
+        fflush(stdout);
+        free(occ);
+        hsr_gridlist_free(g);
+#undef COL
+#undef ROW
+    }
+    free(e);
+    return 0;
+}
+
+/* ---- hsr: full build of a scene ------------------------------------ */
+static int count_visible(const hsr_ctx *h)
+{
+    int n = 0;
+    for (int s = 0; s < hsr_llr_slots(h); s++) n += hsr_llr_get(h, s, NULL, NULL, NULL, NULL);
+    return n;
+}
+
+static hsr_scene *load(const char *path)
+{
+    char err[1024] = "";
+    hsr_scene *sc;
+    hsr_status st = hsr_scene_load(path, &sc, err, sizeof err);
+    if (st != HSR_OK) { fprintf(stderr, "%s\n", err[0] ? err : hsr_status_str(st)); return NULL; }
+    return sc;
+}
+
+static int cmd_hsr(int argc, char **argv)
+{
+    if (argc < 3) return usage();
+    int rep = argc > 3 ? atoi(argv[3]) : 1;
+    hsr_scene *sc = load(argv[2]);
+    if (!sc) return 1;
+    double best = INFINITY;
+    int vis = 0;
+    for (int r = 0; r < rep; r++) {
+        hsr_ctx *h; double *shade;
+        double t0 = now();
+        hsr_status st = hsr_scene_build(sc, &h, &shade);
+        double dt = now() - t0;
+        if (st != HSR_OK) { fprintf(stderr, "%s: %s\n", argv[2], hsr_status_str(st)); return 1; }
+        if (dt < best) best = dt;
+        vis = count_visible(h);
+        free(shade);
+        hsr_destroy(h);
+    }
+    printf("faces %d visible %d seconds %.6f\n", sc->nf, vis, best);
+    hsr_scene_free(sc);
+    return 0;
+}
+
+/* ---- stack: tri-steps / tri-spets (Fig 5.29) ----------------------- */
+static int cmd_stack(int argc, char **argv)
+{
+    if (argc < 4) return usage();
+    int steps = !strcmp(argv[2], "steps");
+    if (!steps && strcmp(argv[2], "spets")) return usage();
+    int n = atoi(argv[3]), rep = argc > 4 ? atoi(argv[4]) : 1;
+    int rev = argc > 5 && !strcmp(argv[5], "reverse");
+    if (n < 1) return usage();
+    const int64_t SMAX = (int64_t)1 << 18;
+    hsr_config cfg = {{0, 0, SMAX, SMAX}, 32, 32};
+    double best = INFINITY;
+    int vis = 0;
+    for (int r = 0; r < rep; r++) {
+        hsr_ctx *h;
+        if (hsr_create(&cfg, &h) != HSR_OK) return 1;
+        double t0 = now();
+        for (int k = 0; k < n; k++) {
+            int i = rev ? n - 1 - k : k;
+            int64_t s = SMAX * (n - i) / n;      /* i = 0 is the largest */
+            int64_t tri[6] = {0, 0, s, 0, 0, s};
+            int len = 3, id;
+            /* depth: tri-steps: larger = farther; tri-spets: larger = nearer */
+            hsr_plane pl = {0, 0, steps ? (double)(n - i) : (double)i};
+            if (hsr_add(h, tri, &len, 1, pl, 1.0, &id) != HSR_OK) { fprintf(stderr, "add failed\n"); return 1; }
+        }
+        double dt = now() - t0;
+        if (dt < best) best = dt;
+        vis = count_visible(h);
+        hsr_destroy(h);
+    }
+    printf("triangles %d visible %d seconds %.6f\n", n, vis, best);
+    return 0;
+}
+
+/* ---- move: incremental move of K faces vs a full rebuild ----------- */
+static int to_rings(const hsr_domain *d, int64_t **xy, int **len, int *nr)
+{
+    double *dxy; int *dl, n;
+    if (hsr_domain_rings(d, &dxy, &dl, &n) != HSR_OK) return 0;
+    int tot = 0;
+    for (int i = 0; i < n; i++) tot += dl[i];
+    *xy = malloc(sizeof(int64_t) * 2 * (size_t)(tot + 1));
+    for (int i = 0; i < 2 * tot; i++) {
+        (*xy)[i] = llround(dxy[i]);
+        if (fabs(dxy[i] - (double)(*xy)[i]) > 1e-6) { free(dxy); free(dl); return 0; }  /* not integer */
+    }
+    *len = dl; *nr = n;
+    free(dxy);
+    return 1;
+}
+
+typedef struct geom { int64_t *xy; int *len; int nr; hsr_plane pl; } geom;
+
+static int grab(const hsr_ctx *h, int id, geom *g)
+{
+    const hsr_domain *d;
+    if (!hsr_mlr_get(h, id, &d, &g->pl, NULL, NULL, NULL)) return 0;
+    if (!to_rings(d, &g->xy, &g->len, &g->nr)) return 0;
+    if (g->nr == 0) {               /* empty domain: one ring of length 0 */
+        free(g->len); g->len = calloc(1, sizeof(int)); g->nr = 1;
+    }
+    return 1;
+}
+
+static void areas(const hsr_ctx *h, double *a, int n)
+{
+    for (int i = 0; i < n; i++) a[i] = 0;
+    for (int s = 0; s < hsr_llr_slots(h); s++) {
+        const hsr_domain *d; const int *par; int nv, np;
+        if (hsr_llr_get(h, s, &d, &par, &nv, &np) && par[0] < n) a[par[0]] += hsr_domain_area(d);
+    }
+}
+
+static int cmd_move(int argc, char **argv)
+{
+    if (argc < 5) return usage();
+    int K = atoi(argv[4]), rep = argc > 5 ? atoi(argv[5]) : 3;
+    hsr_scene *sa = load(argv[2]), *sb = load(argv[3]);
+    if (!sa || !sb) return 1;
+    if (sa->nf != sb->nf || K < 1 || K > sa->nf) { fprintf(stderr, "scenes differ in face count or bad K\n"); return 1; }
+    int n = sa->nf;
+    hsr_ctx *ha, *hb; double *shade;
+    double t_build = INFINITY, t_rebuild = INFINITY, t_move = INFINITY, t_back = INFINITY;
+    for (int r = 0; r < rep; r++) {
+        double t0 = now();
+        if (hsr_scene_build(sa, &ha, &shade) != HSR_OK) return 1;
+        double dt = now() - t0;
+        if (dt < t_build) t_build = dt;
+        free(shade);
+        if (r + 1 < rep) hsr_destroy(ha);
+    }
+    if (hsr_scene_build(sb, &hb, &shade) != HSR_OK) return 1;
+    free(shade);
+    geom *ga = calloc((size_t)K, sizeof *ga), *gb = calloc((size_t)K, sizeof *gb);
+    for (int k = 0; k < K; k++)
+        if (!grab(ha, n - K + k, &ga[k]) || !grab(hb, n - K + k, &gb[k])) {
+            fprintf(stderr, "cannot take face geometry\n"); return 1;
+        }
+    int ok = 1;
+    double *aa = malloc(sizeof(double) * (size_t)n), *ab = malloc(sizeof(double) * (size_t)n);
+    areas(hb, ab, n);
+    for (int r = 0; r < rep; r++) {
+        double t0 = now();
+        for (int k = 0; k < K; k++)
+            if (hsr_move(ha, n - K + k, gb[k].xy, gb[k].len, gb[k].nr, gb[k].pl) != HSR_OK) { fprintf(stderr, "move failed\n"); return 1; }
+        double dt = now() - t0;
+        if (dt < t_move) t_move = dt;
+        if (r == 0) {
+            areas(ha, aa, n);
+            for (int i = 0; i < n; i++)
+                if (fabs(aa[i] - ab[i]) > 1e-9 * fmax(fabs(ab[i]), 65536.0)) {
+                    printf("mismatch: MLR %d visible area after move %.17g, full build %.17g\n", i, aa[i], ab[i]);
+                    ok = 0;
+                }
+            if (hsr_check(ha) != HSR_OK) { printf("mismatch: hsr_check failed after move\n"); ok = 0; }
+        }
+        t0 = now();
+        for (int k = 0; k < K; k++)
+            if (hsr_move(ha, n - K + k, ga[k].xy, ga[k].len, ga[k].nr, ga[k].pl) != HSR_OK) { fprintf(stderr, "move failed\n"); return 1; }
+        dt = now() - t0;
+        if (dt < t_back) t_back = dt;
+        t0 = now();
+        if (hsr_rebuild(ha) != HSR_OK) return 1;
+        dt = now() - t0;
+        if (dt < t_rebuild) t_rebuild = dt;
+    }
+    printf("faces %d moved %d visible_a %d visible_b %d build %.6f rebuild %.6f move %.6f move_back %.6f check %s\n",
+           n, K, count_visible(ha), count_visible(hb), t_build, t_rebuild, t_move, t_back, ok ? "ok" : "MISMATCH");
+    for (int k = 0; k < K; k++) { free(ga[k].xy); free(ga[k].len); free(gb[k].xy); free(gb[k].len); }
+    free(ga); free(gb); free(aa); free(ab);
+    hsr_destroy(ha); hsr_destroy(hb);
+    hsr_scene_free(sa); hsr_scene_free(sb);
+    return ok ? 0 : 1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) return usage();
+    if (!strcmp(argv[1], "grid")) return cmd_grid(argc, argv);
+    if (!strcmp(argv[1], "hsr")) return cmd_hsr(argc, argv);
+    if (!strcmp(argv[1], "stack")) return cmd_stack(argc, argv);
+    if (!strcmp(argv[1], "move")) return cmd_move(argc, argv);
+    return usage();
+}
