@@ -1,0 +1,86 @@
+// FPGA measurement wrapper for ONE Difference Engine chip (de_chip, Kuijk 1995 7.4.5).
+//
+// Not part of the design: it only gives place-and-route a top whose every timed path
+// starts and ends at a flip-flop, and which needs a dozen pins whatever NumPe is, so the
+// same wrapper fits a 48-pin iCE40 UP5K and an ECP5 and fmax is PE-to-PE, not pin-bound.
+//
+//   pins -> serial-in shift register (id, data, pix_valid, pix: 61 bits) -> de_chip
+//   de_chip's registered outputs -> two-stage registered XOR fold -> 1 pin
+//
+// The shift register gives every chip input an arbitrary, independent value (nothing can
+// be folded as constant); the XOR fold makes every chip output observable, so synthesis
+// keeps the whole chip. The configuration and observation chain pins are registered
+// and passed through as they are. de_chip registers its own outputs (boundary
+// registers), so the only combinational paths inside are the chip's.
+module chip_top #(
+  parameter int unsigned NumPe    = 9,
+  parameter int unsigned CarryBug = 0
+) (
+  input  logic clk_i,
+  input  logic rst_i,
+  input  logic sin_i,         // serial stimulus for the 61 bus input bits
+  input  logic cfg_mode_i,
+  input  logic cfg_bit_i,
+  input  logic obs_load_i,
+  input  logic obs_shift_i,
+  input  logic obs_bit_i,
+  output logic cfg_bit_o,
+  output logic obs_bit_o,
+  output logic fold_o         // XOR of every chip output bit, registered
+);
+  localparam int unsigned InW  = 12 + 36 + 1 + 12;             // id, data, pix_valid, pix
+  localparam int unsigned OutW = 12 + 36 + 1 + 12 + NumPe + 1; // + bypass, collision
+  localparam int unsigned Grp  = 4;                            // XOR inputs per LUT
+  localparam int unsigned NGrp = (OutW + Grp - 1) / Grp;
+
+  logic             rst_q, cfg_mode_q, cfg_bit_q, obs_load_q, obs_shift_q, obs_bit_q;
+  logic [InW-1:0]   sh_q;
+  logic [11:0]      id_o;
+  logic [35:0]      data_o;
+  logic             pix_valid_o, collision_o;
+  logic [11:0]      pix_o;
+  logic [NumPe-1:0] bypass_o;
+  logic [NGrp*Grp-1:0] out_vec;
+  logic [NGrp-1:0]  fold1_q;
+  logic             fold_q;
+
+  always_ff @(posedge clk_i) begin
+    rst_q       <= rst_i;
+    cfg_mode_q  <= cfg_mode_i;
+    cfg_bit_q   <= cfg_bit_i;
+    obs_load_q  <= obs_load_i;
+    obs_shift_q <= obs_shift_i;
+    obs_bit_q   <= obs_bit_i;
+    sh_q        <= {sh_q[InW-2:0], sin_i};
+  end
+
+  de_chip #(.NumPe(NumPe), .CarryBug(CarryBug)) u_chip (
+    .clk_i,
+    .rst_i      (rst_q),
+    .id_i       (sh_q[11:0]),
+    .data_i     (sh_q[47:12]),
+    .id_o,
+    .data_o,
+    .pix_valid_i(sh_q[48]),
+    .pix_i      (sh_q[60:49]),
+    .pix_valid_o,
+    .pix_o,
+    .cfg_mode_i (cfg_mode_q),
+    .cfg_bit_i  (cfg_bit_q),
+    .cfg_bit_o,
+    .obs_load_i (obs_load_q),
+    .obs_shift_i(obs_shift_q),
+    .obs_bit_i  (obs_bit_q),
+    .obs_bit_o,
+    .bypass_o,
+    .collision_o
+  );
+
+  assign out_vec = (NGrp * Grp)'({collision_o, bypass_o, pix_o, pix_valid_o, data_o, id_o});
+
+  always_ff @(posedge clk_i) begin
+    for (int g = 0; g < NGrp; g++) fold1_q[g] <= ^out_vec[g*Grp +: Grp];
+    fold_q <= ^fold1_q;
+  end
+  assign fold_o = fold_q;
+endmodule

