@@ -15,7 +15,7 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: help setup demo test test-py test-c test-rtl test-long bench clean waves lint
+.PHONY: help setup demo test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        render the shipped default command file to out/demo.png"
@@ -25,6 +25,8 @@ help:
 	@echo "make waves TEST=<cocotb test> [PE=p] [BUG=0|1]"
 	@echo "                 FST + GTKWave save file for one PE (docs/debugging.md)"
 	@echo "make lint        verilator -Wall and verible lint on every RTL file"
+	@echo "make fpga        yosys + nextpnr: one 9-PE chip on ECP5 and iCE40, 640-PE fit (fpga/)"
+	@echo "make bench-hsr   HSR benchmarks (Table 5.2, Fig 5.30) into docs/performance.md"
 	@echo "make setup       create .venv from scripts/requirements.txt"
 	@echo "make clean       remove build products (keeps .venv)"
 
@@ -60,6 +62,12 @@ waves: $(SETUP)
 
 lint: $(SETUP)
 	$(ENV) ./scripts/lint.sh
+
+fpga: $(SETUP)
+	$(MAKE) -C fpga all
+
+bench-hsr: $(SETUP)
+	$(MAKE) -C sw/hsr bench-hsr
 
 bench: $(SETUP)
 	$(ENV) $(PY) scripts/bench_model.py --write
