@@ -9,7 +9,8 @@
  *       (hsr_gridlist_query's count, including the entry that stops a list),
  *       empty cells addressed (counted as memory accesses, as footnote 10 of
  *       section 5.3.3 does) and extents actually overlapping, summed over all
- *       queries.
+ *       queries, and mean_ratio: the mean over queries with at least one
+ *       overlap of (entries + empty cells) / overlaps.
  *   hsr_bench hsr SCENE [REPEAT]
  *       Builds the scene (projection + incremental HSR of every face, in
  *       order) REPEAT times; prints faces, visible domains, best seconds.
@@ -88,22 +89,26 @@ static int cmd_grid(int argc, char **argv)
             if (hsr_gridlist_insert(g, i, e[i]) != HSR_OK) { fprintf(stderr, "insert failed\n"); return 1; }
             occ[ROW(e[i].bot) * m + COL(e[i].left)]++;
         }
-        long long entries = 0, empty = 0, over = 0;
+        long long entries = 0, empty = 0, over = 0, nhit = 0;
+        double ratio_sum = 0;   /* mean over queries with >= 1 overlap of addressed / overlaps */
         double t0 = now();
         for (int qy = 0; qy < nq; qy++)
             for (int qx = 0; qx < nq; qx++) {
                 int64_t cx = (int64_t)((qx + 0.5) * (double)W / nq), cy = (int64_t)((qy + 0.5) * (double)W / nq);
                 hsr_extent q = {cx - Q / 2, cy - Q / 2, cx - Q / 2 + Q, cy - Q / 2 + Q};
-                long hits = 0;
-                entries += hsr_gridlist_query(g, q, count_cb, &hits);
+                long hits = 0, qe = 0;
+                long vis = hsr_gridlist_query(g, q, count_cb, &hits);
+                entries += vis;
                 over += hits;
                 int c0 = COL(q.left - wmax), c1 = COL(q.right), r0 = ROW(q.bot - hmax), r1 = ROW(q.top);
                 for (int rr = r0; rr <= r1; rr++)
-                    for (int cc = c0; cc <= c1; cc++) empty += occ[rr * m + cc] == 0;
+                    for (int cc = c0; cc <= c1; cc++) qe += occ[rr * m + cc] == 0;
+                empty += qe;
+                if (hits > 0) { ratio_sum += (double)(vis + qe) / (double)hits; nhit++; }
             }
         double dt = now() - t0;
-        printf("grid %d entries %lld empty_cells %lld overlaps %lld queries %d seconds %.6f\n",
-               m, entries, empty, over, nq * nq, dt);
+        printf("grid %d entries %lld empty_cells %lld overlaps %lld queries %d mean_ratio %.6f seconds %.6f\n",
+               m, entries, empty, over, nq * nq, nhit ? ratio_sum / (double)nhit : 0.0, dt);
         fflush(stdout);
         free(occ);
         hsr_gridlist_free(g);
