@@ -329,6 +329,9 @@ def build_parser() -> argparse.ArgumentParser:
     # Listed for --help only; main() hands `encode` to diffengine.encode.encode_main.
     sub.add_parser("encode", help="image -> multiresolution spline command file "
                    "(diffengine encode -h)")
+    # Listed for --help only; main() hands `trace` to diffengine.trace.trace_main.
+    sub.add_parser("trace", help="per-PE state per cycle from the RTL harness or the "
+                   "structural model, breakpoints, RTL-vs-model compare (diffengine trace -h)")
     return p
 
 
@@ -337,6 +340,9 @@ def main(argv=None) -> int:
     if argv[:1] == ["encode"]:  # its own argument parser (diffengine.encode)
         from .encode import encode_main
         return encode_main(argv[1:])
+    if argv[:1] == ["trace"]:  # its own argument parser (diffengine.trace)
+        from .trace import trace_main
+        return trace_main(argv[1:])
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
