@@ -1,0 +1,82 @@
+"""Frames on disk: 12-bit RGB frames -> 16-bit PNG (value << 4) and an 8-bit view via
+OpenImageIO; raw .dcf frames of the display_controller harness (dc_harness.read_dcf).
+
+    python -m diffengine.frame IN.dcf OUT.png [--frame K] [--view8 OUT8.png]
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+
+def _write(path, arr: np.ndarray, fmt: str, software: str) -> None:
+    import OpenImageIO as oiio
+
+    h, w = arr.shape[:2]
+    ch = 1 if arr.ndim == 2 else arr.shape[2]
+    spec = oiio.ImageSpec(w, h, ch, fmt)
+    spec.attribute("Software", software)
+    out = oiio.ImageOutput.create(str(path))
+    if out is None:
+        raise OSError(f"{path}: cannot write this image type ({oiio.geterror()})")
+    ok = out.open(str(path), spec) and out.write_image(np.ascontiguousarray(arr.reshape(h, w, ch)))
+    err = out.geterror()
+    out.close()
+    if not ok:
+        raise OSError(f"{path}: {err or 'write failed'}")
+
+
+def write_png16(path, frame12: np.ndarray, software: str = "diffengine") -> None:
+    """12-bit pixels (H, W[, 3]) -> 16-bit PNG/TIFF with all 12 bits as value << 4."""
+    f = np.asarray(frame12)
+    if f.min(initial=0) < 0 or f.max(initial=0) > 4095:
+        raise ValueError("write_png16 wants 12-bit values 0..4095")
+    _write(path, f.astype(np.uint16) << 4, "uint16", software)
+
+
+def view8(frame12: np.ndarray) -> np.ndarray:
+    """The 8-bit view: the top 8 of the 12 bits (pixel >> 4), as the DAC window w = 4."""
+    return (np.asarray(frame12).astype(np.uint16) >> 4).astype(np.uint8)
+
+
+def write_png8(path, frame12: np.ndarray, software: str = "diffengine") -> None:
+    _write(path, view8(frame12), "uint8", software)
+
+
+def read_png16(path) -> np.ndarray:
+    """Inverse of write_png16: the 12-bit values."""
+    import OpenImageIO as oiio
+
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise OSError(f"{path}: {oiio.geterror()}")
+    arr = inp.read_image("uint16")
+    inp.close()
+    return (np.asarray(arr) >> 4).astype(np.uint16)
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    from .dc_harness import read_dcf
+
+    ap = argparse.ArgumentParser(description="display_controller raw frame (.dcf) -> PNG")
+    ap.add_argument("input")
+    ap.add_argument("output", help="16-bit PNG")
+    ap.add_argument("--frame", type=int, default=-1, help="frame index (default: last)")
+    ap.add_argument("--view8", help="also write an 8-bit view (pixel >> 4)")
+    a = ap.parse_args(argv)
+    frames = read_dcf(a.input)
+    f = frames[a.frame]
+    write_png16(a.output, f)
+    if a.view8:
+        write_png8(a.view8, f)
+    print(f"{a.output}: {f.shape[1]} x {f.shape[0]} RGB, frame {a.frame % len(frames)} of "
+          f"{len(frames)}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,493 @@
+"""Numpy reference renderer: z-buffer + per-sample Phong, 16x16 supersampled.
+
+The shading model is the normative one shared with the C y-processor (docs/shading.md):
+directional lights, ambient, per-vertex smooth normals (area-weighted, `vn` overrides,
+`flat` materials use the face normal), two-sided, perspective-correct barycentric normal
+interpolation, local viewer, I_c = A kd_c + sum_l I_l,c (kd_c max(0, N.L) +
+KS max(0, E.R)^N), transparency o I_front + (1 - o) C_behind front to back over the
+`background`. 1.0 = 4095 pixel units.
+
+Geometry mirrors sw/hsr/src/project.c exactly: the camera basis (w = eye - at, u = up x w,
+v = w x u), f = (H/2) / tan(fov/2), near clipping at z_eye <= -near in eye space, screen
+x = W/2 + f x_e / -z_e, y = H/2 - f y_e / -z_e (y down), vertices quantised to
+1/256 pixel (llround) like the HSR's input. Pixel (x, y) covers [x, x+1) x [y, y+1).
+
+Sampling: S x S sub-samples per pixel at the sub-square centres (x + (i + 0.5)/S, ...),
+a z-buffer per sub-sample (depth = 1/distance along the view axis, affine in screen
+space as in project.c), per-sample Phong with the true per-point normal and eye vector,
+transparency resolved per sub-sample by depth peeling, box average. S = 1 is the
+point-sampled (anti-aliasing off) image at pixel centres. Sample ties on an edge follow
+a top-left rule, so a sample on an edge shared by two triangles is counted once.
+
+Work is done in bands of pixel rows (memory bounded: about 60 MB per band of 16 rows at
+S = 16 and 640 columns), triangles binned per band.
+"""
+from __future__ import annotations
+
+import math
+import sys
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+SUBPIXEL = 256          # HSR_SUBPIXEL: the HSR quantises vertices to 1/256 pixel
+PIXEL_SCALE = 4095.0    # intensity 1.0 = 4095 pixel units
+
+
+class SceneError(ValueError):
+    """A scene or OBJ file the reference cannot read ("file:line: message")."""
+
+
+@dataclass
+class Material:
+    name: str
+    kd: tuple[float, float, float]
+    opacity: float = 1.0
+    ks: float = 0.0
+    n: float = 1.0
+    flat: bool = False
+
+
+@dataclass
+class Scene:
+    width: int = 640
+    height: int = 480
+    eye: tuple = (0.0, 0.0, 5.0)
+    at: tuple = (0.0, 0.0, 0.0)
+    up: tuple = (0.0, 1.0, 0.0)
+    fov: float = 60.0
+    near: float = 0.1
+    ambient: float = 0.2
+    background: tuple = (1.0, 1.0, 1.0)
+    lights: list = field(default_factory=list)       # [(L unit (3,), I rgb (3,))]
+    materials: list = field(default_factory=list)
+    # Triangles (after fan triangulation of polygons): world positions (T,3,3), vertex
+    # normals (T,3,3) (unnormalised is fine; flat faces carry the face normal), material
+    # index (T,).
+    pos: np.ndarray = None
+    nrm: np.ndarray = None
+    mat: np.ndarray = None
+
+
+def _nums(tok, n, where):
+    try:
+        v = [float(t) for t in tok[:n]]
+    except ValueError:
+        raise SceneError(f"{where}: bad number") from None
+    if len(v) != n or not all(math.isfinite(x) for x in v):
+        raise SceneError(f"{where}: needs {n} finite numbers")
+    return v
+
+
+def _tokens(line: str) -> list[str]:
+    return line.split("#", 1)[0].split()
+
+
+def _newell(p: np.ndarray) -> np.ndarray:
+    """Newell normal of polygon(s) p (..., n, 3): unnormalised, |.| = 2 area."""
+    q = np.roll(p, -1, axis=-2)
+    return np.stack([((p[..., 1] - q[..., 1]) * (p[..., 2] + q[..., 2])).sum(-1),
+                     ((p[..., 2] - q[..., 2]) * (p[..., 0] + q[..., 0])).sum(-1),
+                     ((p[..., 0] - q[..., 0]) * (p[..., 1] + q[..., 1])).sum(-1)], -1)
+
+
+def _read_obj(path: Path, default_mat: int, names: dict[str, int], tris, norms, mats) -> None:
+    """Append the OBJ's triangles; smooth normals are per file (shared vertex indices)."""
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise SceneError(f"{path}: cannot read ({e.strerror})") from None
+    verts, vns, faces = [], [], []   # faces: (vertex idx list, normal idx list|None, mat)
+    cur = default_mat
+    for lineno, line in enumerate(text.splitlines(), 1):
+        tok = _tokens(line)
+        if not tok:
+            continue
+        where = f"{path}:{lineno}"
+        if tok[0] == "v":
+            verts.append(_nums(tok[1:4], 3, where))
+        elif tok[0] == "vn":
+            vns.append(_nums(tok[1:4], 3, where))
+        elif tok[0] == "f":
+            if len(tok) < 4:
+                raise SceneError(f"{where}: face needs at least 3 vertices")
+            vi, ni = [], []
+            for t in tok[1:]:
+                parts = t.split("/")
+                try:
+                    v = int(parts[0])
+                    n = int(parts[2]) if len(parts) > 2 and parts[2] else None
+                except ValueError:
+                    raise SceneError(f"{where}: bad vertex index {t!r}") from None
+                v = v - 1 if v > 0 else len(verts) + v
+                if not 0 <= v < len(verts):
+                    raise SceneError(f"{where}: vertex index out of range")
+                if n is not None:
+                    n = n - 1 if n > 0 else len(vns) + n
+                    if not 0 <= n < len(vns):
+                        raise SceneError(f"{where}: normal index out of range")
+                vi.append(v)
+                ni.append(n)
+            faces.append((vi, ni, cur))
+        elif tok[0] == "usemtl" and len(tok) > 1:
+            cur = names.get(tok[1], default_mat)
+    if not faces:
+        return
+    V = np.array(verts, dtype=np.float64)
+    VN = np.array(vns, dtype=np.float64) if vns else np.zeros((0, 3))
+    acc = np.zeros_like(V)
+    fn = []
+    for vi, _, _ in faces:
+        n = _newell(V[vi])
+        fn.append(n)
+        np.add.at(acc, vi, n)
+    ln = np.linalg.norm(acc, axis=1, keepdims=True)
+    smooth = np.divide(acc, ln, out=np.zeros_like(acc), where=ln > 0)
+    for (vi, ni, m), n in zip(faces, fn):
+        corner = []
+        for v, k in zip(vi, ni):
+            corner.append(VN[k] if k is not None else smooth[v])
+        for j in range(1, len(vi) - 1):          # fan, as the polygon's own plane
+            tris.append(V[[vi[0], vi[j], vi[j + 1]]])
+            norms.append(np.stack([corner[0], corner[j], corner[j + 1]]))
+            mats.append((m, n))
+
+
+def load_scene(path) -> Scene:
+    """Parse a scene file (docs/hsr.md + docs/shading.md extensions) and its OBJ files."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise SceneError(f"{path}: cannot read ({e.strerror})") from None
+    sc = Scene()
+    sc.materials = [Material("default", (0.8, 0.8, 0.8))]
+    names = {"default": 0}
+    tris, norms, mats = [], [], []
+    for lineno, line in enumerate(text.splitlines(), 1):
+        tok = _tokens(line)
+        if not tok:
+            continue
+        k, where = tok[0], f"{path}:{lineno}"
+        if k == "screen":
+            w, h = _nums(tok[1:], 2, where)
+            sc.width, sc.height = int(w), int(h)
+        elif k == "camera":
+            if len(tok) != 15 or (tok[1], tok[5], tok[9], tok[13]) != ("eye", "at", "up", "fov"):
+                raise SceneError(f"{where}: expected 'camera eye X Y Z at X Y Z up X Y Z fov DEG'")
+            sc.eye = tuple(_nums(tok[2:5], 3, where))
+            sc.at = tuple(_nums(tok[6:9], 3, where))
+            sc.up = tuple(_nums(tok[10:13], 3, where))
+            sc.fov = _nums(tok[14:], 1, where)[0]
+        elif k == "near":
+            sc.near = _nums(tok[1:], 1, where)[0]
+        elif k == "light":
+            if len(tok) == 5:
+                v = _nums(tok[1:], 4, where)
+                rgb = (v[3],) * 3
+            elif len(tok) == 7:
+                v = _nums(tok[1:], 6, where)
+                rgb = tuple(v[3:6])
+            else:
+                raise SceneError(f"{where}: 'light DX DY DZ I' or 'light DX DY DZ R G B'")
+            L = np.array(v[:3])
+            if not np.linalg.norm(L) > 0:
+                raise SceneError(f"{where}: zero light direction")
+            sc.lights.append((L / np.linalg.norm(L), np.array(rgb, dtype=np.float64)))
+        elif k == "ambient":
+            sc.ambient = _nums(tok[1:], 1, where)[0]
+        elif k == "background":
+            sc.background = tuple(_nums(tok[1:], 3, where))
+        elif k == "material":
+            if len(tok) < 5:
+                raise SceneError(f"{where}: expected 'material NAME R G B [opacity O] "
+                                 "[specular KS N] [flat]'")
+            m = Material(tok[1], tuple(_nums(tok[2:5], 3, where)))
+            i = 5
+            while i < len(tok):
+                if tok[i] == "opacity":
+                    m.opacity = _nums(tok[i + 1:i + 2], 1, where)[0]
+                    i += 2
+                elif tok[i] == "specular":
+                    m.ks, m.n = _nums(tok[i + 1:i + 3], 2, where)
+                    i += 3
+                elif tok[i] in ("flat", "smooth"):
+                    m.flat = tok[i] == "flat"
+                    i += 1
+                elif tok[i] == "shading" and i + 1 < len(tok):
+                    m.flat = tok[i + 1] == "flat"
+                    i += 2
+                else:
+                    raise SceneError(f"{where}: unknown material option {tok[i]!r}")
+            names[m.name] = len(sc.materials)
+            sc.materials.append(m)
+        elif k == "obj":
+            if len(tok) == 4 and tok[2] == "material":
+                if tok[3] not in names:
+                    raise SceneError(f"{where}: unknown material {tok[3]!r}")
+                mat = names[tok[3]]
+            elif len(tok) == 2:
+                mat = 0
+            else:
+                raise SceneError(f"{where}: expected 'obj PATH [material NAME]'")
+            p = Path(tok[1])
+            _read_obj(p if p.is_absolute() else path.parent / p, mat, names, tris, norms, mats)
+        elif k == "grid":
+            pass
+        else:
+            warnings.warn(f"{where}: statement {k!r} ignored by the reference renderer",
+                          stacklevel=2)
+    if not sc.lights:   # scene.c's default light
+        sc.lights.append((np.ones(3) / math.sqrt(3), np.full(3, 0.8)))
+    sc.pos = np.array(tris, dtype=np.float64).reshape(-1, 3, 3)
+    nv = np.array(norms, dtype=np.float64).reshape(-1, 3, 3)
+    midx = np.array([m for m, _ in mats], dtype=np.int64)
+    fnorm = np.array([n for _, n in mats], dtype=np.float64).reshape(-1, 3)
+    flat = np.array([sc.materials[m].flat for m in midx], dtype=bool)
+    nv[flat] = fnorm[flat][:, None, :]
+    sc.nrm, sc.mat = nv, midx
+    return sc
+
+
+def _llround(v: np.ndarray) -> np.ndarray:
+    return np.sign(v) * np.floor(np.abs(v) + 0.5)
+
+
+@dataclass
+class Projected:
+    """Screen-space triangles: xy (T,3,2) in pixels (quantised), iz (T,3) = 1/depth,
+    world positions and vertex normals (T,3,3), material index (T,)."""
+    xy: np.ndarray
+    iz: np.ndarray
+    pos: np.ndarray
+    nrm: np.ndarray
+    mat: np.ndarray
+
+
+def camera(sc: Scene):
+    eye, at, up = (np.array(t, dtype=np.float64) for t in (sc.eye, sc.at, sc.up))
+    w = eye - at
+    u = np.cross(up, w)
+    w /= np.linalg.norm(w)
+    u /= np.linalg.norm(u)
+    v = np.cross(w, u)
+    f = (sc.height / 2) / math.tan(sc.fov * math.pi / 360.0)
+    return eye, u, v, w, f
+
+
+def project(sc: Scene, quantise: bool = True) -> Projected:
+    eye, u, v, w, f = camera(sc)
+    d = sc.pos - eye
+    E = np.stack([d @ u, d @ v, d @ w], -1)            # eye space (T,3,3)
+    inside = E[..., 2] <= -sc.near
+    keep_all = inside.all(1)
+    out_xyz, out_pos, out_nrm, out_mat = [E[keep_all]], [sc.pos[keep_all]], \
+        [sc.nrm[keep_all]], [sc.mat[keep_all]]
+    # Triangles crossing the near plane: clip in eye space (project.c's clip()),
+    # attributes interpolated along the cut edges, fan back into triangles.
+    for t in np.flatnonzero(inside.any(1) & ~keep_all):
+        pts = []
+        for i in range(3):
+            a, b = i, (i + 1) % 3
+            da, db = E[t, a, 2] + sc.near, E[t, b, 2] + sc.near
+            if da <= 0:
+                pts.append((E[t, a], sc.pos[t, a], sc.nrm[t, a]))
+            if (da < 0 < db) or (da > 0 > db):
+                s = da / (da - db)
+                pts.append(tuple(x[t, a] + s * (x[t, b] - x[t, a]) for x in (E, sc.pos, sc.nrm)))
+        for j in range(1, len(pts) - 1):
+            tri = [pts[0], pts[j], pts[j + 1]]
+            out_xyz.append(np.array([[p[0] for p in tri]]))
+            out_pos.append(np.array([[p[1] for p in tri]]))
+            out_nrm.append(np.array([[p[2] for p in tri]]))
+            out_mat.append(np.array([sc.mat[t]]))
+    E = np.concatenate(out_xyz)
+    iz = 1.0 / -E[..., 2]
+    xy = np.stack([sc.width / 2 + f * E[..., 0] * iz, sc.height / 2 - f * E[..., 1] * iz], -1)
+    if quantise:
+        xy = _llround(xy * SUBPIXEL) / SUBPIXEL
+    return Projected(xy, iz, np.concatenate(out_pos), np.concatenate(out_nrm),
+                     np.concatenate(out_mat))
+
+
+class _Raster:
+    """Per-triangle edge setup: screen-linear barycentrics and the top-left tie rule."""
+
+    def __init__(self, P: Projected):
+        x, y = P.xy[..., 0], P.xy[..., 1]
+        area = (x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (x[:, 2] - x[:, 0]) * (y[:, 1] - y[:, 0])
+        self.ok = np.abs(area) > 0
+        sgn = np.where(area < 0, -1.0, 1.0)
+        # edge i is opposite vertex i: e_i(p) = sgn * cross(v_{i+2} - v_{i+1}, p - v_{i+1})
+        self.A = np.zeros((len(x), 3))
+        self.B = np.zeros((len(x), 3))
+        self.C = np.zeros((len(x), 3))
+        self.bias = np.zeros((len(x), 3), dtype=bool)   # True: a sample on this edge counts
+        for i in range(3):
+            j, k = (i + 1) % 3, (i + 2) % 3
+            ex, ey = x[:, k] - x[:, j], y[:, k] - y[:, j]
+            self.A[:, i] = -sgn * ey
+            self.B[:, i] = sgn * ex
+            self.C[:, i] = sgn * (ey * x[:, j] - ex * y[:, j])
+            # top-left rule in the orientation where inside is e > 0
+            self.bias[:, i] = (self.B[:, i] < 0) | ((self.B[:, i] == 0) & (self.A[:, i] > 0))
+        self.area = np.abs(area)
+        self.ymin = y.min(1)
+        self.ymax = y.max(1)
+        self.xmin = x.min(1)
+        self.xmax = x.max(1)
+
+
+def render(sc: Scene, samples: int = 16, band: int = 16, quantise: bool = True,
+           progress=None) -> np.ndarray:
+    """The frame as float (H, W, 3) in pixel units (1.0 = 4095)."""
+    S = samples
+    W, H = sc.width, sc.height
+    P = project(sc, quantise)
+    R = _Raster(P)
+    opacity = np.array([m.opacity for m in sc.materials])[P.mat]
+    kd = np.array([m.kd for m in sc.materials])[P.mat]
+    ks = np.array([m.ks for m in sc.materials])[P.mat]
+    kn = np.array([m.n for m in sc.materials])[P.mat]
+    opaque = opacity >= 1.0
+    eye, u, v, w, f = camera(sc)
+    bg = np.array(sc.background, dtype=np.float64)
+    out = np.zeros((H, W, 3))
+    alltri = np.flatnonzero(R.ok)
+    for y0 in range(0, H, band):
+        y1 = min(H, y0 + band)
+        ny, nx = (y1 - y0) * S, W * S
+        sy = y0 + (np.arange(ny) + 0.5) / S           # sample y coordinates of the band
+        sx = (np.arange(nx) + 0.5) / S
+        tri = alltri[(R.ymax[alltri] >= y0) & (R.ymin[alltri] <= y1)]
+
+        def raster(sel, zmin=None, zmax=None):
+            """Nearest fragment of the triangles `sel` per sample, with iz in
+            (zmin, zmax) when given: returns (iz, id, l1, l2) (id -1 = none)."""
+            zb = np.full((ny, nx), -np.inf)
+            ids = np.full((ny, nx), -1, dtype=np.int64)
+            l1 = np.zeros((ny, nx))
+            l2 = np.zeros((ny, nx))
+            for t in sel:
+                i0 = max(0, int(math.floor((R.ymin[t] - y0) * S - 0.5)))
+                i1 = min(ny, int(math.ceil((R.ymax[t] - y0) * S + 0.5)))
+                j0 = max(0, int(math.floor(R.xmin[t] * S - 0.5)))
+                j1 = min(nx, int(math.ceil(R.xmax[t] * S + 0.5)))
+                if i1 <= i0 or j1 <= j0:
+                    continue
+                X = sx[None, j0:j1]
+                Y = sy[i0:i1, None]
+                e = [R.A[t, k] * X + R.B[t, k] * Y + R.C[t, k] for k in range(3)]
+                m = np.ones((i1 - i0, j1 - j0), dtype=bool)
+                for k in range(3):
+                    m &= (e[k] > 0) | ((e[k] == 0) & R.bias[t, k])
+                if not m.any():
+                    continue
+                a0, a1 = e[0] / R.area[t], e[1] / R.area[t]
+                z = a0 * P.iz[t, 0] + a1 * P.iz[t, 1] + (1 - a0 - a1) * P.iz[t, 2]
+                zs = zb[i0:i1, j0:j1]
+                m &= z > zs
+                if zmin is not None:
+                    m &= z > zmin[i0:i1, j0:j1]
+                if zmax is not None:
+                    m &= z < zmax[i0:i1, j0:j1]
+                zs[m] = z[m]
+                ids[i0:i1, j0:j1][m] = t
+                l1[i0:i1, j0:j1][m] = a0[m]
+                l2[i0:i1, j0:j1][m] = a1[m]
+            return zb, ids, l1, l2
+
+        def shade(zb, ids, l1, l2):
+            """Phong colour (ny, nx, 3) at the samples with ids >= 0 (others 0)."""
+            col = np.zeros((ny, nx, 3))
+            hit = ids >= 0
+            if not hit.any():
+                return col
+            t = ids[hit]
+            a0, a1 = l1[hit], l2[hit]
+            a = np.stack([a0, a1, 1 - a0 - a1], -1) * P.iz[t]     # perspective-correct
+            a /= a.sum(-1, keepdims=True)
+            N = np.einsum("si,sij->sj", a, P.nrm[t])
+            N /= np.linalg.norm(N, axis=-1, keepdims=True)
+            # the surface point from the screen position and its depth (exactly the
+            # plane of the projected triangle at this sample)
+            yy, xx = np.nonzero(hit)
+            depth = 1.0 / zb[hit]
+            xe = (sx[xx] - W / 2) * depth / f
+            ye = (H / 2 - sy[yy]) * depth / f
+            Pw = eye + xe[:, None] * u + ye[:, None] * v - depth[:, None] * w
+            Ev = eye - Pw
+            Ev /= np.linalg.norm(Ev, axis=-1, keepdims=True)
+            flip = (N * Ev).sum(-1) < 0
+            N[flip] = -N[flip]
+            I = sc.ambient * kd[t]
+            for L, Il in sc.lights:
+                nl = N @ L
+                R_ = 2 * nl[:, None] * N - L
+                er = np.maximum(0.0, (Ev * R_).sum(-1))
+                spec = ks[t] * np.power(er, kn[t])
+                I = I + Il * (kd[t] * np.maximum(0.0, nl)[:, None] + spec[:, None])
+            col[hit] = I
+            return col
+
+        zo, io, l1o, l2o = raster(tri[opaque[tri]])
+        col = shade(zo, io, l1o, l2o)
+        col[io < 0] = bg
+        ttri = tri[~opaque[tri]]
+        if len(ttri):
+            # depth peeling of the transparent layers in front of the opaque surface,
+            # front to back: C = sum_k T_k o_k I_k + T C_opaque, T_{k+1} = T_k (1 - o_k)
+            acc = np.zeros_like(col)
+            T = np.ones((ny, nx))
+            front = np.full((ny, nx), np.inf)
+            while True:
+                zt, it, l1t, l2t = raster(ttri, zmin=zo, zmax=front)
+                if not (it >= 0).any():
+                    break
+                o = np.where(it >= 0, opacity[np.maximum(it, 0)], 0.0)
+                acc += (T * o)[..., None] * shade(zt, it, l1t, l2t)
+                T *= 1 - o
+                front = np.where(it >= 0, zt, -np.inf)
+            col = acc + T[..., None] * col
+        out[y0:y1] = col.reshape(y1 - y0, S, W, S, 3).mean(axis=(1, 3))
+        if progress:
+            progress(y1, H)
+    return out * PIXEL_SCALE
+
+
+def render_file(path, samples: int = 16, progress=None) -> np.ndarray:
+    return render(load_scene(path), samples=samples, progress=progress)
+
+
+def psnr(frame: np.ndarray, ref: np.ndarray, peak: float = PIXEL_SCALE) -> float:
+    """PSNR in dB over all channels (12-bit frame, peak 4095)."""
+    mse = float(np.mean((np.asarray(frame, dtype=np.float64) - ref) ** 2))
+    return math.inf if mse == 0 else 10 * math.log10(peak * peak / mse)
+
+
+def main(argv=None) -> int:
+    import argparse
+    import time
+
+    ap = argparse.ArgumentParser(description="numpy reference renderer (16x16 Phong)")
+    ap.add_argument("scene")
+    ap.add_argument("-o", "--output", required=True, help="16-bit PNG (or .npy float frame)")
+    ap.add_argument("--samples", type=int, default=16)
+    a = ap.parse_args(argv)
+    t0 = time.monotonic()
+    img = render_file(a.scene, a.samples,
+                      progress=lambda d, n: print(f"\rreference: {d}/{n} rows", end="",
+                                                  file=sys.stderr))
+    print(f"\nreference: {time.monotonic() - t0:.1f} s", file=sys.stderr)
+    if a.output.endswith(".npy"):
+        np.save(a.output, img)
+    else:
+        from .frame import write_png16
+        write_png16(a.output, np.clip(np.round(img), 0, 4095).astype(np.uint16))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
