@@ -3,8 +3,20 @@
 // one instruction per clock, collects the pixels that leave the last PE and writes a
 // raw frame (.depx: "DEPX", u32 width, u32 height, then u16 little-endian pixels),
 // which `diffengine` converts to PNG. Prints simulated cycles per second.
+// A command file (.cmd text or .de32) is assembled first by `diffengine asm` (once,
+// before the clock loop).
 //
-//   array_harness IN.de48 OUT.depx [--width N] [--repeat K] [--quiet] [--trace-pixels]
+// docs/simulation.md is the manual: cycle and line numbering, the windows, the trace
+// CSV columns, the breakpoints and their exit status (3).
+//
+//   array_harness IN.(de48|cmd|de32) OUT.depx [--width N] [--repeat K] [--quiet]
+//       [--trace-pixels] [--list-ops]
+//     trace-enabled builds (make -C sim harness TRACE=1) also take:
+//       [--from-cycle C] [--to-cycle C] | [--line L]        the window
+//       [--fst FILE.fst [--col Q]]                          FST of the window + FILE.gtkw
+//       [--trace-pes LIST --trace-csv FILE|-]               per-PE state per cycle
+//       [--break-cycle C | --break-line L | --break-pe P --break-op OP]
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -12,27 +24,54 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 #include "Vde_array.h"
 #include "verilated.h"
+#ifdef DE_TRACE
+#include "verilated_fst_c.h"
+#include "verilated_syms.h"
+#endif
 
 namespace {
+
+constexpr int kExitBreak = 3;   // a breakpoint stopped the run
+constexpr uint16_t kRefresh = 0x100;
+constexpr int kPixLatency = 3;  // docs/array.md: exit(q) = R + NumChips + 3 + q
+constexpr int kPePerChip = 9;
 
 struct Instr {
   uint16_t ident;
   uint64_t data;
 };
 
-bool read_de48(const char* path, std::vector<Instr>& out, std::string& err) {
-  FILE* f = std::fopen(path, "rb");
+// The 19 identifiers of the instruction look-up table, as sw/diffengine/isa.py LUT
+// names them (--list-ops prints this table; a test compares it with isa.LUT).
+struct OpName {
+  const char* name;
+  uint16_t ident;
+};
+const OpName kOps[] = {
+    {"NOP", 0x000},        {"REFRESH", 0x100},       {"ACCMODE_ON", 0x001},
+    {"ACCMODE_OFF", 0x002}, {"ADDR_RANGE", 0x800},    {"ADDR_PERIODIC", 0x801},
+    {"ADDR_EVAL0", 0x802}, {"ADDR_DIS", 0x803},      {"ACC", 0x200},
+    {"D_A", 0x444},        {"D_B", 0x484},           {"D_C", 0x4c4},
+    {"D_B_C", 0x4b4},      {"D_A_B", 0x464},         {"D_A_B_NP", 0x460},
+    {"D_A_A_NP", 0x450},   {"SET_A", 0x448},         {"SET_B", 0x488},
+    {"SET_C", 0x4c8},
+};
+
+bool read_de48(const std::string& path, std::vector<Instr>& out, std::string& err) {
+  FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) {
-    err = std::string(path) + ": cannot open";
+    err = path + ": cannot open";
     return false;
   }
   unsigned char hdr[8];
   if (std::fread(hdr, 1, 8, f) != 8 || std::memcmp(hdr, "DE48", 4) != 0) {
-    err = std::string(path) + ": not a DE48 instruction stream (bad header)";
+    err = path + ": not a DE48 instruction stream (bad header)";
     std::fclose(f);
     return false;
   }
@@ -45,41 +84,426 @@ bool read_de48(const char* path, std::vector<Instr>& out, std::string& err) {
   }
   std::fclose(f);
   if (n != 0) {
-    err = std::string(path) + ": truncated instruction at byte " +
-          std::to_string(8 + 6 * out.size());
+    err = path + ": truncated instruction at byte " + std::to_string(8 + 6 * out.size());
     return false;
   }
   return true;
 }
 
+bool is_de48(const std::string& path) {
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return true;  // let read_de48 report it
+  char hdr[4] = {0, 0, 0, 0};
+  const size_t n = std::fread(hdr, 1, 4, f);
+  std::fclose(f);
+  return n == 4 && std::memcmp(hdr, "DE48", 4) == 0;
+}
+
+// Repository root: DE_ROOT, else four levels above the executable
+// (<root>/sim/build/<config>/Vde_array).
+std::string repo_root() {
+  if (const char* r = std::getenv("DE_ROOT")) return r;
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return ".";
+  std::string p(buf, static_cast<size_t>(n));
+  for (int i = 0; i < 4; ++i) p = p.substr(0, p.rfind('/'));
+  return p;
+}
+
+// A .cmd text or .de32 frame store: `diffengine asm` turns it into a .de48 first.
+bool assemble(const std::string& in, std::string& out, std::string& err) {
+  char tmpl[] = "/tmp/array_harness_XXXXXX";
+  const int fd = mkstemp(tmpl);
+  if (fd < 0) {
+    err = "cannot create a temporary file";
+    return false;
+  }
+  close(fd);
+  out = tmpl;
+  const std::string root = repo_root();
+  const std::string log = out + ".log";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // Its messages go to a log, shown only when it fails.
+    FILE* lf = std::fopen(log.c_str(), "w");
+    if (lf) dup2(fileno(lf), 2);
+    const std::string py = root + "/.venv/bin/python";
+    const std::string pp = root + "/sw";
+    setenv("PYTHONPATH", pp.c_str(), 1);
+    const char* code = "import sys; from diffengine.cli import main; sys.exit(main(sys.argv[1:]))";
+    execl(py.c_str(), py.c_str(), "-c", code, "asm", in.c_str(), "-o", out.c_str(),
+          static_cast<char*>(nullptr));
+    execlp("python3", "python3", "-c", code, "asm", in.c_str(), "-o", out.c_str(),
+           static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (!ok) {
+    err = in + ": `diffengine asm` failed";
+    if (FILE* lf = std::fopen(log.c_str(), "r")) {
+      char line[512];
+      while (std::fgets(line, sizeof line, lf)) err += std::string("\n  ") + line;
+      std::fclose(lf);
+    }
+  }
+  std::remove(log.c_str());
+  return ok;
+}
+
+bool parse_num(const char* s, long long& v) {
+  char* end = nullptr;
+  v = std::strtoll(s, &end, 0);
+  return end && *end == '\0' && end != s;
+}
+
+// "0,5,17-19" or "all" -> sorted unique list of PEs below n_pe.
+bool parse_pe_list(const std::string& spec, int n_pe, std::vector<int>& out,
+                   std::string& err) {
+  std::vector<char> want(static_cast<size_t>(n_pe), 0);
+  if (spec == "all") {
+    for (int p = 0; p < n_pe; ++p) want[p] = 1;
+  } else {
+    size_t pos = 0;
+    while (pos <= spec.size()) {
+      size_t comma = spec.find(',', pos);
+      if (comma == std::string::npos) comma = spec.size();
+      const std::string item = spec.substr(pos, comma - pos);
+      long long lo, hi;
+      const size_t dash = item.find('-', 1);
+      bool ok = dash == std::string::npos
+                    ? parse_num(item.c_str(), lo) && (hi = lo, true)
+                    : parse_num(item.substr(0, dash).c_str(), lo) &&
+                          parse_num(item.substr(dash + 1).c_str(), hi);
+      if (!ok || lo < 0 || hi < lo || hi >= n_pe) {
+        err = "PE list item '" + item + "' is not a PE or range within 0.." +
+              std::to_string(n_pe - 1);
+        return false;
+      }
+      for (long long p = lo; p <= hi; ++p) want[static_cast<size_t>(p)] = 1;
+      pos = comma + 1;
+    }
+  }
+  for (int p = 0; p < n_pe; ++p)
+    if (want[p]) out.push_back(p);
+  return true;
+}
+
+bool parse_op(const char* s, int& ident) {
+  for (const OpName& o : kOps)
+    if (!strcasecmp(s, o.name)) {
+      ident = o.ident;
+      return true;
+    }
+  long long v;
+  if (parse_num(s, v) && v >= 0 && v < 4096) {
+    ident = static_cast<int>(v);
+    return true;
+  }
+  return false;
+}
+
+// The stream as the clock loop plays it: the input with Nops inserted so that two
+// Refreshes are at least n_pe cycles apart (one Refresh active at a time, 7.4.1; the
+// access controller's fixed line period does this in the real system), then Nops to
+// drain the array. Cycle c of one play is seq[c].
+std::vector<Instr> pad_stream(const std::vector<Instr>& prog, int n_pe, uint64_t& nops) {
+  std::vector<Instr> seq;
+  seq.reserve(prog.size() + 64);
+  uint64_t since_refresh = static_cast<uint64_t>(n_pe);
+  nops = 0;
+  for (const Instr& in : prog) {
+    if (in.ident == kRefresh)
+      for (; since_refresh < static_cast<uint64_t>(n_pe); ++since_refresh, ++nops)
+        seq.push_back({0, 0});
+    seq.push_back(in);
+    since_refresh = in.ident == kRefresh ? 1 : since_refresh + 1;
+  }
+  const size_t drain = static_cast<size_t>(n_pe) * 2 + 64;
+  seq.insert(seq.end(), drain, Instr{0, 0});
+  return seq;
+}
+
+struct Options {
+  int width = 0, repeat = 1;
+  bool quiet = false, trace_pixels = false, list_ops = false;
+  long long from = -1, to = -1, line = -1;
+  std::string fst, pes_spec, csv;
+  long long col = -1;
+  long long break_cycle = -1, break_line = -1, break_pe = -1;
+  int break_op = -1;
+  bool tracing() const {
+    return !fst.empty() || !csv.empty() || break_cycle >= 0 || break_line >= 0 ||
+           break_pe >= 0;
+  }
+};
+
+#ifdef DE_TRACE
+// ---- per-PE state, read from the Verilated model's public signals -----------------
+struct Sig {
+  void* p = nullptr;
+  VerilatedVarType t = VLVT_UNKNOWN;
+  uint64_t get() const {
+    switch (t) {
+      case VLVT_UINT8: return *static_cast<const CData*>(p);
+      case VLVT_UINT16: return *static_cast<const SData*>(p);
+      case VLVT_UINT32: return *static_cast<const IData*>(p);
+      case VLVT_UINT64: return *static_cast<const QData*>(p);
+      default: return 0;
+    }
+  }
+};
+
+const VerilatedScope* find_scope(const std::string& name) {
+  const VerilatedScope* s = Verilated::scopeFind(("TOP." + name).c_str());
+  return s ? s : Verilated::scopeFind(name.c_str());
+}
+
+bool bind(const VerilatedScope* s, const char* var, Sig& out, std::string& err) {
+  VerilatedVar* v = s ? s->varFind(var) : nullptr;
+  if (!v || v->vltype() == VLVT_WDATA || v->vltype() == VLVT_UNKNOWN) {
+    err = std::string("no public signal ") + (s ? s->name() : "?") + "." + var;
+    return false;
+  }
+  out.p = v->datap();
+  out.t = v->vltype();
+  return true;
+}
+
+std::string pe_scope(int p) {
+  return "de_array.g_chip[" + std::to_string(p / kPePerChip) + "].u_chip.g_pe[" +
+         std::to_string(p % kPePerChip) + "].u_pe";
+}
+
+// The registers of one PE, in trace-CSV column order (docs/simulation.md).
+const char* const kRegNames[] = {
+    "a_q", "b_q", "c_q", "d_q", "pa_q", "pb_q", "pc_q", "dis_q", "lock_q", "accm_q",
+    "act_q", "id_q", "id2_q", "out_q", "c1_q", "c2_q", "accc2_q", "accc3_q", "xz1_q",
+    "act1_q", "prot1_q", "act2_q", "prot2_q", "e0wr2_q", "accen2_q", "accen3_q",
+    "pixv_q", "pix_q"};
+constexpr int kNumRegs = sizeof kRegNames / sizeof kRegNames[0];
+
+struct PeProbe {
+  int pe;
+  Sig reg[kNumRegs];
+  Sig in_id, in_data;  // upstream registers (PE p-1 or the chip boundary); PE 0: none
+  Sig skew1, skew2;    // PE 0 only: de_skew's block-1 and block-2 registers
+};
+
+bool make_probe(int p, PeProbe& pr, std::string& err) {
+  pr.pe = p;
+  const VerilatedScope* s = find_scope(pe_scope(p));
+  if (!s) {
+    err = "no scope " + pe_scope(p) + " (is this a TRACE=1 build?)";
+    return false;
+  }
+  for (int i = 0; i < kNumRegs; ++i)
+    if (!bind(s, kRegNames[i], pr.reg[i], err)) return false;
+  if (p == 0) {
+    const VerilatedScope* sk = find_scope("de_array.u_skew");
+    return bind(sk, "blk1_q", pr.skew1, err) && bind(sk, "blk2_q2", pr.skew2, err);
+  }
+  if (p % kPePerChip) {
+    const VerilatedScope* up = find_scope(pe_scope(p - 1));
+    return bind(up, "id_q", pr.in_id, err) && bind(up, "out_q", pr.in_data, err);
+  }
+  const VerilatedScope* chip =
+      find_scope("de_array.g_chip[" + std::to_string(p / kPePerChip - 1) + "].u_chip");
+  return bind(chip, "id_q", pr.in_id, err) && bind(chip, "data_q", pr.in_data, err);
+}
+
+// One row: cycle,pe,ident,data,A,B,C,D,flags,id1,id2,out,c1,c2,accc2,accc3,xz1,act1,
+// prot1,act2,prot2,e0wr2,accen2,accen3,pix_valid,pix,line
+std::string state_row(uint64_t cycle, const PeProbe& pr, const Instr& in0, long long line) {
+  uint64_t v[kNumRegs];
+  for (int i = 0; i < kNumRegs; ++i) v[i] = pr.reg[i].get();
+  uint64_t id, data;
+  if (pr.pe == 0) {
+    id = in0.ident;
+    data = (in0.data & 0xFFF) | (pr.skew1.get() << 12) | (pr.skew2.get() << 24);
+  } else {
+    id = pr.in_id.get();
+    data = pr.in_data.get();
+  }
+  char flags[8];
+  const char letters[] = "ABCdlma";
+  for (int i = 0; i < 7; ++i) flags[i] = v[4 + i] ? letters[i] : '.';
+  flags[7] = '\0';
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%llu,%d,%03llx,%09llx,%09llx,%09llx,%09llx,%09llx,%s,%03llx,%03llx,%09llx,"
+                "%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%03llx,%lld",
+                static_cast<unsigned long long>(cycle), pr.pe,
+                static_cast<unsigned long long>(id), static_cast<unsigned long long>(data),
+                static_cast<unsigned long long>(v[0]), static_cast<unsigned long long>(v[1]),
+                static_cast<unsigned long long>(v[2]), static_cast<unsigned long long>(v[3]),
+                flags, static_cast<unsigned long long>(v[11]),
+                static_cast<unsigned long long>(v[12]), static_cast<unsigned long long>(v[13]),
+                static_cast<unsigned long long>(v[14]), static_cast<unsigned long long>(v[15]),
+                static_cast<unsigned long long>(v[16]), static_cast<unsigned long long>(v[17]),
+                static_cast<unsigned long long>(v[18]), static_cast<unsigned long long>(v[19]),
+                static_cast<unsigned long long>(v[20]), static_cast<unsigned long long>(v[21]),
+                static_cast<unsigned long long>(v[22]), static_cast<unsigned long long>(v[23]),
+                static_cast<unsigned long long>(v[24]), static_cast<unsigned long long>(v[25]),
+                static_cast<unsigned long long>(v[26]), static_cast<unsigned long long>(v[27]),
+                line);
+  return buf;
+}
+
+const char* const kCsvHeader =
+    "cycle,pe,ident,data,A,B,C,D,flags,id1,id2,out,c1,c2,accc2,accc3,xz1,act1,prot1,"
+    "act2,prot2,e0wr2,accen2,accen3,pix_valid,pix,line";
+
+// GTKWave save file for the PEs `pes` (names as Verilator's FST writer spells them).
+bool write_gtkw(const std::string& fst, const std::vector<int>& pes, uint64_t t0,
+                std::string& err) {
+  std::string path = fst;
+  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".fst") == 0)
+    path.resize(path.size() - 4);
+  path += ".gtkw";
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    err = path + ": cannot write";
+    return false;
+  }
+  char cwd[4096];
+  std::string abs = fst;
+  if (fst[0] != '/' && getcwd(cwd, sizeof cwd)) abs = std::string(cwd) + "/" + fst;
+  std::fprintf(f, "[dumpfile] \"%s\"\n[timestart] %llu\n[size] 1800 1000\n"
+               "[sst_expanded] 0\n@28\nTOP.clk_i\n@22\nTOP.ident_i[11:0]\nTOP.data_i[35:0]\n"
+               "@28\nTOP.pixel_valid_o\n@22\nTOP.pixel_o[11:0]\n",
+               abs.c_str(), static_cast<unsigned long long>(t0));
+  for (int p : pes) {
+    const std::string s = "TOP." + pe_scope(p) + ".";
+    std::fprintf(f, "-PE %d (chip %d, PE %d): identifier and skewed data in\n@22\n%sid_i[11:0]\n"
+                 "%sdata_i[35:0]\n", p, p / kPePerChip, p % kPePerChip, s.c_str(), s.c_str());
+    std::fprintf(f, "-PE %d registers A-D as 12-bit blocks ([2] = integer part)\n", p);
+    for (const char* r : {"a_q", "b_q", "c_q", "d_q"})
+      for (int j = 2; j >= 0; --j) std::fprintf(f, "%s%s.%s[%d][11:0]\n", s.c_str(), r, r, j);
+    std::fprintf(f, "-PE %d block carries: c1 (0->1), c2 (1->2); ACC accc2, accc3\n@28\n", p);
+    for (const char* r : {"c1_q", "c2_q", "accc2_q", "accc3_q", "accen2_q", "accen3_q"})
+      std::fprintf(f, "%s%s\n", s.c_str(), r);
+    std::fprintf(f, "-PE %d protect / disable / lock / acc_mode / act\n", p);
+    for (const char* r : {"pa_q", "pb_q", "pc_q", "dis_q", "lock_q", "accm_q", "act_q"})
+      std::fprintf(f, "%s%s\n", s.c_str(), r);
+    std::fprintf(f, "-PE %d data passed on, pixel out\n@22\n%sout_q.out_q[2][11:0]\n"
+                 "%sout_q.out_q[1][11:0]\n%sout_q.out_q[0][11:0]\n@28\n%spix_valid_o\n@22\n"
+                 "%spix_o[11:0]\n",
+                 p, s.c_str(), s.c_str(), s.c_str(), s.c_str(), s.c_str());
+  }
+  std::fclose(f);
+  return true;
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: %s IN.de48 OUT.depx [--width N] [--repeat K] [--quiet]\n",
+    std::fprintf(stderr,
+                 "usage: %s IN.(de48|cmd|de32) OUT.depx [--width N] [--repeat K] [--quiet]\n"
+                 "  [--trace-pixels] [--list-ops] [--from-cycle C] [--to-cycle C] [--line L]\n"
+                 "  [--fst FILE.fst] [--col Q] [--trace-pes LIST] [--trace-csv FILE|-]\n"
+                 "  [--break-cycle C] [--break-line L] [--break-pe P --break-op OP]\n",
                  argv[0]);
     return 2;
   }
-  int width = 0, repeat = 1;
-  bool quiet = false, trace_pixels = false, collided = false;
+  Options o;
   for (int i = 3; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--width") && i + 1 < argc) width = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--quiet")) quiet = true;
-    else if (!std::strcmp(argv[i], "--trace-pixels")) trace_pixels = true;
-    else {
-      std::fprintf(stderr, "%s: unknown option %s\n", argv[0], argv[i]);
+    const char* a = argv[i];
+    const bool has = i + 1 < argc;
+    long long v = 0;
+    auto num = [&](long long& dst) {
+      if (!has || !parse_num(argv[i + 1], v) || v < 0) {
+        std::fprintf(stderr, "%s: %s wants a number >= 0\n", argv[0], a);
+        std::exit(2);
+      }
+      dst = v;
+      ++i;
+    };
+    auto str = [&](std::string& dst) {
+      if (!has) {
+        std::fprintf(stderr, "%s: %s wants an argument\n", argv[0], a);
+        std::exit(2);
+      }
+      dst = argv[++i];
+    };
+    long long tmp;
+    if (!std::strcmp(a, "--width")) num(tmp), o.width = static_cast<int>(tmp);
+    else if (!std::strcmp(a, "--repeat")) num(tmp), o.repeat = static_cast<int>(tmp);
+    else if (!std::strcmp(a, "--quiet")) o.quiet = true;
+    else if (!std::strcmp(a, "--trace-pixels")) o.trace_pixels = true;
+    else if (!std::strcmp(a, "--list-ops")) o.list_ops = true;
+    else if (!std::strcmp(a, "--from-cycle")) num(o.from);
+    else if (!std::strcmp(a, "--to-cycle")) num(o.to);
+    else if (!std::strcmp(a, "--line")) num(o.line);
+    else if (!std::strcmp(a, "--fst")) str(o.fst);
+    else if (!std::strcmp(a, "--col")) num(o.col);
+    else if (!std::strcmp(a, "--trace-pes")) str(o.pes_spec);
+    else if (!std::strcmp(a, "--trace-csv")) str(o.csv);
+    else if (!std::strcmp(a, "--break-cycle")) num(o.break_cycle);
+    else if (!std::strcmp(a, "--break-line")) num(o.break_line);
+    else if (!std::strcmp(a, "--break-pe")) num(o.break_pe);
+    else if (!std::strcmp(a, "--break-op")) {
+      if (!has || !parse_op(argv[i + 1], o.break_op)) {
+        std::fprintf(stderr, "%s: --break-op wants a mnemonic (--list-ops) or an "
+                     "identifier 0..0xfff\n", argv[0]);
+        return 2;
+      }
+      ++i;
+    } else {
+      std::fprintf(stderr, "%s: unknown option %s\n", argv[0], a);
       return 2;
     }
   }
+  if (o.list_ops) {
+    for (const OpName& op : kOps) std::printf("%s 0x%03x\n", op.name, op.ident);
+    return 0;
+  }
+  if (o.repeat < 1) o.repeat = 1;
+  if ((o.break_pe >= 0) != (o.break_op >= 0)) {
+    std::fprintf(stderr, "%s: --break-pe and --break-op go together\n", argv[0]);
+    return 2;
+  }
+  if (o.line >= 0 && (o.from >= 0 || o.to >= 0)) {
+    std::fprintf(stderr, "%s: --line and --from-cycle/--to-cycle exclude each other\n",
+                 argv[0]);
+    return 2;
+  }
+  if (!o.csv.empty() && o.pes_spec.empty()) {
+    std::fprintf(stderr, "%s: --trace-csv needs --trace-pes\n", argv[0]);
+    return 2;
+  }
+#ifndef DE_TRACE
+  if (o.tracing()) {
+    std::fprintf(stderr, "%s: --fst, --trace-csv and the breakpoints need the trace build "
+                 "(make -C sim harness TRACE=1)\n", argv[0]);
+    return 2;
+  }
+#endif
+
   std::vector<Instr> prog;
-  std::string err;
-  if (!read_de48(argv[1], prog, err)) {
+  std::string err, in_path = argv[1], tmp_path;
+  if (!is_de48(in_path)) {
+    if (!assemble(in_path, tmp_path, err)) {
+      std::fprintf(stderr, "%s\n", err.c_str());
+      return 1;
+    }
+    in_path = tmp_path;
+  }
+  const bool read_ok = read_de48(in_path, prog, err);
+  if (!tmp_path.empty()) std::remove(tmp_path.c_str());
+  if (!read_ok) {
     std::fprintf(stderr, "%s\n", err.c_str());
     return 1;
   }
   auto ctx = std::make_unique<VerilatedContext>();
   ctx->commandArgs(1, argv);
+#ifdef DE_TRACE
+  ctx->traceEverOn(true);
+#endif
   auto top = std::make_unique<Vde_array>(ctx.get());
   top->eval();
   const int n_pe = top->n_pe_o;  // the array reports its own column count
@@ -87,7 +511,114 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s: the array reports %d PEs\n", argv[0], n_pe);
     return 1;
   }
-  if (width <= 0 || width > n_pe) width = n_pe;
+  const int n_chips = n_pe / kPePerChip;
+  const int width = (o.width <= 0 || o.width > n_pe) ? n_pe : o.width;
+
+  uint64_t nops_added = 0;
+  const std::vector<Instr> seq = pad_stream(prog, n_pe, nops_added);
+  const uint64_t play = seq.size();
+  const uint64_t total = play * static_cast<uint64_t>(o.repeat);
+  // Refresh cycles of every line of the whole run (all repeats), in order.
+  std::vector<uint64_t> refresh_at;
+  for (int r = 0; r < o.repeat; ++r)
+    for (uint64_t c = 0; c < play; ++c)
+      if (seq[c].ident == kRefresh) refresh_at.push_back(r * play + c);
+  auto line_of_slot = [&](long long slot) -> long long {  // the line slot `slot` belongs to
+    if (slot < 0) return 0;
+    return std::lower_bound(refresh_at.begin(), refresh_at.end(),
+                            static_cast<uint64_t>(slot)) - refresh_at.begin();
+  };
+
+  // The window: --line L = from the cycle Refresh L-1 is on ident_i (cycle 0 for L = 0)
+  // to the cycle line L's last pixel is on pixel_o.
+  uint64_t w_from = 0, w_to = total ? total - 1 : 0;
+  if (o.line >= 0) {
+    if (static_cast<uint64_t>(o.line) >= refresh_at.size()) {
+      std::fprintf(stderr, "%s: --line %lld: the stream has lines 0..%lld\n", argv[0], o.line,
+                   static_cast<long long>(refresh_at.size()) - 1);
+      return 2;
+    }
+    w_from = o.line ? refresh_at[o.line - 1] : 0;
+    w_to = refresh_at[o.line] + n_chips + kPixLatency + n_pe - 1;
+  } else {
+    if (o.from >= 0) w_from = static_cast<uint64_t>(o.from);
+    if (o.to >= 0) w_to = static_cast<uint64_t>(o.to);
+  }
+  if (w_to >= total) w_to = total ? total - 1 : 0;
+  if (w_from > w_to) {
+    std::fprintf(stderr, "%s: empty window %llu..%llu\n", argv[0],
+                 static_cast<unsigned long long>(w_from), static_cast<unsigned long long>(w_to));
+    return 2;
+  }
+  uint64_t break_at = UINT64_MAX;
+  if (o.break_cycle >= 0) break_at = static_cast<uint64_t>(o.break_cycle);
+  if (o.break_line >= 0) {
+    if (static_cast<uint64_t>(o.break_line) >= refresh_at.size()) {
+      std::fprintf(stderr, "%s: --break-line %lld: the stream has lines 0..%lld\n", argv[0],
+                   o.break_line, static_cast<long long>(refresh_at.size()) - 1);
+      return 2;
+    }
+    // Line L starts when its first instruction is on ident_i.
+    const uint64_t c = o.break_line ? refresh_at[o.break_line - 1] + 1 : 0;
+    break_at = std::min(break_at, c);
+  }
+  if (o.break_pe >= n_pe) {
+    std::fprintf(stderr, "%s: --break-pe %lld: the array has PEs 0..%d\n", argv[0],
+                 o.break_pe, n_pe - 1);
+    return 2;
+  }
+
+#ifdef DE_TRACE
+  std::vector<int> trace_pes;
+  if (!o.pes_spec.empty() && !parse_pe_list(o.pes_spec, n_pe, trace_pes, err)) {
+    std::fprintf(stderr, "%s: --trace-pes: %s\n", argv[0], err.c_str());
+    return 2;
+  }
+  // PEs shown at a breakpoint: --trace-pes, else the break PE and its neighbours, else 0..2.
+  std::vector<int> show = trace_pes;
+  if (show.empty()) {
+    const long long c = o.break_pe >= 0 ? o.break_pe : (o.col >= 0 ? o.col : 1);
+    for (long long p = std::max(0LL, c - 1); p <= std::min<long long>(n_pe - 1, c + 1); ++p)
+      show.push_back(static_cast<int>(p));
+  }
+  std::vector<int> probe_pes = show;
+  if (o.break_pe >= 0) probe_pes.push_back(static_cast<int>(o.break_pe));
+  std::vector<PeProbe> probes(probe_pes.size());
+  for (size_t i = 0; i < probe_pes.size(); ++i)
+    if (!make_probe(probe_pes[i], probes[i], err)) {
+      std::fprintf(stderr, "%s: %s\n", argv[0], err.c_str());
+      return 1;
+    }
+  const PeProbe* brk_probe = o.break_pe >= 0 ? &probes.back() : nullptr;
+  FILE* csv = nullptr;
+  if (!o.csv.empty()) {
+    csv = o.csv == "-" ? stdout : std::fopen(o.csv.c_str(), "w");
+    if (!csv) {
+      std::fprintf(stderr, "%s: cannot write\n", o.csv.c_str());
+      return 1;
+    }
+    std::fprintf(csv, "%s\n", kCsvHeader);
+  }
+  std::unique_ptr<VerilatedFstC> fst;
+  std::vector<int> wave_pes;
+  if (!o.fst.empty()) {
+    const long long q = o.col >= 0 ? std::min<long long>(o.col, n_pe - 1) : 1;
+    for (long long p = std::max(0LL, q - 1); p <= std::min<long long>(n_pe - 1, q + 1); ++p)
+      wave_pes.push_back(static_cast<int>(p));
+    fst = std::make_unique<VerilatedFstC>();
+    // Only the top ports, the array level and the chips of the shown PEs are dumped.
+    fst->dumpvars(1, "TOP");
+    fst->dumpvars(1, "TOP.de_array");
+    for (int p : wave_pes)
+      fst->dumpvars(0, "TOP.de_array.g_chip[" + std::to_string(p / kPePerChip) + "]");
+    top->trace(fst.get(), 99);
+  }
+  auto state_of = [&](uint64_t c, const PeProbe& pr) {
+    // The slot on this PE's input in cycle c entered the array at c - pe - chip.
+    const long long slot = static_cast<long long>(c) - pr.pe - pr.pe / kPePerChip;
+    return state_row(c, pr, seq[c % play], line_of_slot(slot));
+  };
+#endif
 
   auto tick = [&]() {
     top->clk_i = 0;
@@ -106,47 +637,78 @@ int main(int argc, char** argv) {
   top->rst_i = 0;
 
   std::vector<uint16_t> pixels;
-  uint64_t cycles = 0;
+  bool collided = false;
+  const bool slow = o.tracing();
   auto t0 = std::chrono::steady_clock::now();
-  const size_t drain = static_cast<size_t>(n_pe) * 2 + 64;
-  // One Refresh active at a time (7.4.1): pixels of two Refreshes fewer than n_pe
-  // cycles apart would meet on the pixel bus, so pad with Nops, as the access
-  // controller's fixed line period does in the real system.
-  uint64_t nops_added = 0;
-  for (int r = 0; r < repeat; ++r) {
-    uint64_t since_refresh = static_cast<uint64_t>(n_pe);
-    size_t i = 0;
-    for (size_t left = drain; i < prog.size() || left > 0;) {
-      Instr in{0, 0};
-      if (i < prog.size()) {
-        in = prog[i];
-        if (in.ident == 0x100 && since_refresh < static_cast<uint64_t>(n_pe)) {
-          in = Instr{0, 0};
-          ++nops_added;
-        } else {
-          ++i;
-        }
-      } else {
-        --left;
-      }
-      since_refresh = (in.ident == 0x100) ? 1 : since_refresh + 1;
+  uint64_t cycle = 0;
+  for (int r = 0; r < o.repeat; ++r) {
+    for (uint64_t i = 0; i < play; ++i, ++cycle) {
+      const Instr& in = seq[i];
       top->ident_i = in.ident;
       top->data_i = in.data;
+#ifdef DE_TRACE
+      if (slow) {
+        // Cycle c spans [10c, 10c+10) in the FST: inputs and registers of cycle c from
+        // 10c (the rising edge that ends cycle c is at 10c+10), clock low from 10c+5.
+        top->eval();
+        const bool in_win = cycle >= w_from && cycle <= w_to;
+        if (fst && cycle == w_from) {
+          fst->open(o.fst.c_str());
+        }
+        if (fst && in_win) fst->dump(10 * cycle);
+        if (csv && in_win)
+          for (size_t k = 0; k < trace_pes.size(); ++k)
+            std::fprintf(csv, "%s\n", state_of(cycle, probes[k]).c_str());
+        bool stop = cycle == break_at;
+        if (brk_probe && !stop) {
+          const uint64_t id = brk_probe->pe == 0 ? in.ident : brk_probe->in_id.get();
+          stop = id == static_cast<uint64_t>(o.break_op);
+        }
+        if (stop) {
+          const long long line = line_of_slot(static_cast<long long>(cycle));
+          std::printf("break: cycle %llu, line %lld (of the instruction on ident_i)",
+                      static_cast<unsigned long long>(cycle), line);
+          if (brk_probe)
+            std::printf(", PE %d (column %d) receives identifier 0x%03x",
+                        brk_probe->pe, brk_probe->pe, o.break_op);
+          std::printf("\n%s\n", kCsvHeader);
+          for (size_t k = 0; k < show.size(); ++k)
+            std::printf("%s\n", state_of(cycle, probes[k]).c_str());
+          if (fst) fst->close();
+          if (csv && csv != stdout) std::fclose(csv);
+          std::fflush(stdout);
+          top->final();
+          return kExitBreak;
+        }
+        top->clk_i = 0;
+        top->eval();
+        if (fst && in_win) fst->dump(10 * cycle + 5);
+        top->clk_i = 1;
+        top->eval();
+        if (fst && cycle == w_to) {
+          fst->dump(10 * cycle + 10);
+          fst->close();
+        }
+      } else {
+        tick();
+      }
+#else
       tick();
-      ++cycles;
+#endif
       if (top->pixel_valid_o && r == 0) pixels.push_back(top->pixel_o);
-      if (trace_pixels && top->pixel_valid_o)
-        std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(cycles),
+      if (o.trace_pixels && top->pixel_valid_o)
+        std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(cycle + 1),
                     pixels.size() - 1, top->pixel_o);
-      if (trace_pixels && in.ident == 0x100)
-        std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(cycles));
+      if (o.trace_pixels && in.ident == kRefresh)
+        std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(cycle + 1));
       if (top->pix_collision_o && !collided) {
         collided = true;
         std::fprintf(stderr, "%s: pixel collision at cycle %llu\n", argv[1],
-                     static_cast<unsigned long long>(cycles));
+                     static_cast<unsigned long long>(cycle + 1));
       }
     }
   }
+  (void)slow;
   if (top->pix_collision_o) {
     std::fprintf(stderr, "%s: pixel collision in the array (Refreshes too close)\n", argv[1]);
     return 1;
@@ -170,11 +732,26 @@ int main(int argc, char** argv) {
   for (uint32_t y = 0; y < height; ++y)
     std::fwrite(&pixels[static_cast<size_t>(y) * n_pe], 2, width, f);
   std::fclose(f);
-  if (!quiet)
+#ifdef DE_TRACE
+  if (csv && csv != stdout) std::fclose(csv);
+  if (fst) {
+    if (!write_gtkw(o.fst, wave_pes, 10 * w_from, err)) {
+      std::fprintf(stderr, "%s\n", err.c_str());
+      return 1;
+    }
+    std::fprintf(stderr, "harness: fst %s cycles %llu..%llu (time %llu..%llu ns), PEs %d..%d\n",
+                 o.fst.c_str(), static_cast<unsigned long long>(w_from),
+                 static_cast<unsigned long long>(w_to),
+                 static_cast<unsigned long long>(10 * w_from),
+                 static_cast<unsigned long long>(10 * w_to + 10), wave_pes.front(),
+                 wave_pes.back());
+  }
+#endif
+  if (!o.quiet)
     std::printf("harness: %d PEs, %zu instructions x %d (+%llu Nops for Refresh spacing), "
-                "%llu cycles in %.3f s = %.0f cycles/s, %u lines\n", n_pe, prog.size(), repeat,
-                static_cast<unsigned long long>(nops_added / (repeat ? repeat : 1)),
-                static_cast<unsigned long long>(cycles), secs, cycles / secs, height);
+                "%llu cycles in %.3f s = %.0f cycles/s, %u lines\n", n_pe, prog.size(),
+                o.repeat, static_cast<unsigned long long>(nops_added),
+                static_cast<unsigned long long>(cycle), secs, cycle / secs, height);
   top->final();
   return 0;
 }

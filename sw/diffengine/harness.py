@@ -1,11 +1,17 @@
 """Run command streams through the Verilated array (sim/harness, plain C++, no Python in
-the clock loop) and read back the frame. Builds are cached per configuration by make."""
+the clock loop) and read back the frame. Builds are cached per configuration by make
+(sim/Makefile; docs/simulation.md).
+
+Two build flavours per configuration: the fast one (trace=False) and the trace one
+(trace=True: FST windows, per-PE state CSV, breakpoints; slower to build and to run).
+"""
 from __future__ import annotations
 
 import os
 import struct
 import subprocess
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -13,24 +19,42 @@ import numpy as np
 from . import binfmt, isa
 
 REPO = Path(__file__).resolve().parents[2]
+EXIT_BREAK = 3  # the harness stopped at a breakpoint
+
+# Verilator threads per chip count where they were measured to help (docs/performance.md,
+# "Verilated array speed"): on the 2-core build machines a second thread pays only for the
+# full 72-chip array; below that the threads' synchronisation costs more than they win.
+THREADS_FROM_CHIPS = 72
 
 
-def build(chips: int, carry_bug: bool = False, threads: int = 1) -> Path:
+def default_threads(chips: int) -> int:
+    """Verilator threads to use for `chips` chips when the caller does not say."""
+    return 2 if chips >= THREADS_FROM_CHIPS and (os.cpu_count() or 1) >= 2 else 1
+
+
+def tag(chips: int, carry_bug: bool = False, threads: int = 1, trace: bool = False) -> str:
+    return f"array_c{chips}_b{int(carry_bug)}_t{threads}_tr{int(trace)}"
+
+
+def build(chips: int, carry_bug: bool = False, threads: int | None = None,
+          trace: bool = False) -> Path:
     """Build (or reuse) the harness for `chips` chips; returns the executable.
 
     A lock file per configuration serialises concurrent callers (pytest-xdist workers
     that need the same build), so make never runs twice in one build folder."""
     import fcntl
 
-    tag = f"array_c{chips}_b{int(carry_bug)}_t{threads}"
+    threads = default_threads(chips) if threads is None else int(threads)
+    name = tag(chips, carry_bug, threads, trace)
     lock_dir = REPO / "sim" / "build"
     lock_dir.mkdir(parents=True, exist_ok=True)
-    with open(lock_dir / f".{tag}.lock", "w") as lock:
+    with open(lock_dir / f".{name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         subprocess.run(["make", "-s", "-C", str(REPO / "sim"), "harness", f"CHIPS={chips}",
-                        f"CARRY_BUG={int(carry_bug)}", f"THREADS={threads}"],
+                        f"CARRY_BUG={int(carry_bug)}", f"THREADS={threads}",
+                        f"TRACE={int(trace)}"],
                        check=True, env=dict(os.environ), stdout=subprocess.DEVNULL)
-    return REPO / "sim" / "build" / tag / "Vde_array"
+    return REPO / "sim" / "build" / name / "Vde_array"
 
 
 def read_depx(path: Path) -> np.ndarray:
@@ -42,9 +66,10 @@ def read_depx(path: Path) -> np.ndarray:
 
 
 def run(commands: list[isa.Command] | None, chips: int, carry_bug: bool = False,
-        slots=None, threads: int = 1, extra_args: tuple[str, ...] = ()) -> tuple[np.ndarray, str]:
+        slots=None, threads: int | None = None, extra_args: tuple[str, ...] = (),
+        trace: bool = False) -> tuple[np.ndarray, str]:
     """Play commands (or raw slots) through the array; returns (frame, harness report)."""
-    exe = build(chips, carry_bug, threads)
+    exe = build(chips, carry_bug, threads, trace)
     if slots is None:
         slots = isa.serialise(commands)
     with tempfile.TemporaryDirectory() as tmp:
@@ -55,3 +80,56 @@ def run(commands: list[isa.Command] | None, chips: int, carry_bug: bool = False,
         if res.returncode:
             raise RuntimeError(f"harness failed: {res.stderr.strip()}")
         return read_depx(dst), res.stdout.strip()
+
+
+@dataclass
+class TraceRun:
+    """What a trace-build run left: exit status (0, or EXIT_BREAK at a breakpoint), its
+    stdout (report or breakpoint print-out), stderr, the trace CSV text (if asked for),
+    the frame (None when stopped at a breakpoint)."""
+    returncode: int
+    stdout: str
+    stderr: str
+    csv: str | None
+    frame: np.ndarray | None
+
+
+def run_traced(slots, chips: int, carry_bug: bool = False, *, pes: str | None = None,
+               window: tuple[int | None, int | None] | None = None, line: int | None = None,
+               fst: Path | None = None, col: int | None = None,
+               break_cycle: int | None = None, break_line: int | None = None,
+               break_pe: int | None = None, break_op: str | int | None = None,
+               threads: int = 1) -> TraceRun:
+    """Run `slots` through the trace build with the harness's trace options
+    (docs/simulation.md). A harness error (exit status other than 0 and 3) raises."""
+    exe = build(chips, carry_bug, threads, trace=True)
+    args: list[str] = []
+    if window is not None:
+        if window[0] is not None:
+            args += ["--from-cycle", str(window[0])]
+        if window[1] is not None:
+            args += ["--to-cycle", str(window[1])]
+    if line is not None:
+        args += ["--line", str(line)]
+    if fst is not None:
+        args += ["--fst", str(fst)]
+    if col is not None:
+        args += ["--col", str(col)]
+    if break_cycle is not None:
+        args += ["--break-cycle", str(break_cycle)]
+    if break_line is not None:
+        args += ["--break-line", str(break_line)]
+    if break_pe is not None:
+        args += ["--break-pe", str(break_pe), "--break-op", str(break_op)]
+    with tempfile.TemporaryDirectory() as tmp:
+        src, dst, csv = Path(tmp) / "in.de48", Path(tmp) / "out.depx", Path(tmp) / "t.csv"
+        src.write_bytes(binfmt.encode_de48(slots))
+        if pes is not None:
+            args += ["--trace-pes", pes, "--trace-csv", str(csv)]
+        res = subprocess.run([str(exe), str(src), str(dst), *args],
+                             capture_output=True, text=True)
+        if res.returncode not in (0, EXIT_BREAK):
+            raise RuntimeError(f"harness failed ({res.returncode}): {res.stderr.strip()}")
+        return TraceRun(res.returncode, res.stdout, res.stderr,
+                        csv.read_text() if pes is not None and csv.exists() else None,
+                        read_depx(dst) if res.returncode == 0 else None)
