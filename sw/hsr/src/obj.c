@@ -85,6 +85,7 @@ hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name, int 
                 sc->fv[sc->nfv + i - 1] = (int)(vbase + idx);
             }
             sc->f[sc->nf].first = sc->nfv; sc->f[sc->nf].count = nt - 1; sc->f[sc->nf].material = mat;
+            sc->f[sc->nf].obj = sc->nobj;
             sc->nf++; sc->nfv += nt - 1;
         } else if (!strcmp(tok[0], "usemtl")) {
             if (nt < 2) FAIL(HSR_EPARSE, "'usemtl' needs a name");

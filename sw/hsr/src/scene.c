@@ -16,8 +16,10 @@ hsr_status hsr_scene_new(hsr_scene **out)
     sc->eye[2] = 5; sc->up[1] = 1; sc->fov_deg = 60; sc->near_z = 0.1;
     sc->light[0] = 1; sc->light[1] = 1; sc->light[2] = 1; sc->light_i = 0.8; sc->ambient = 0.2;
     sc->bg[0] = sc->bg[1] = sc->bg[2] = 1;
+    hsr_light dl = {{1, 1, 1}, {0.8, 0.8, 0.8}, 0};
+    sc->lights[0] = dl; sc->nlights = 1;
     if (!scene_grow((void **)&sc->mat, &sc->capmat, 1, sizeof(hsr_material))) { free(sc); return HSR_ENOMEM; }
-    hsr_material d = {"default", {0.8, 0.8, 0.8}, 1.0};
+    hsr_material d = {"default", {0.8, 0.8, 0.8}, 1.0, 0.0, 1.0, 0, 0};
     sc->mat[0] = d; sc->nmat = 1;
     *out = sc;
     return HSR_OK;
@@ -107,24 +109,51 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             if (nt != 2 || !nums(tok + 1, 1, v) || !(v[0] > 0)) FAIL(HSR_EPARSE, "'near D' needs D > 0");
             sc->near_z = v[0];
         } else if (!strcmp(k, "light")) {
-            if (nt != 5 || !nums(tok + 1, 4, v)) FAIL(HSR_EPARSE, "'light DX DY DZ I' needs 4 finite numbers");
-            memcpy(sc->light, v, sizeof sc->light); sc->light_i = v[3];
+            /* light DX DY DZ I  or  light DX DY DZ R G B; every line adds one */
+            if ((nt != 5 && nt != 7) || !nums(tok + 1, nt - 1, v))
+                FAIL(HSR_EPARSE, "'light DX DY DZ I' or 'light DX DY DZ R G B' needs finite numbers");
+            if (!(v[0] != 0 || v[1] != 0 || v[2] != 0)) FAIL(HSR_EPARSE, "light direction is zero");
+            if (sc->nlights == 1 && sc->lights[0].line == 0) sc->nlights = 0;   /* replace the default */
+            if (sc->nlights == HSR_MAX_LIGHTS) FAIL(HSR_ELIMIT, "more than %d lights", HSR_MAX_LIGHTS);
+            hsr_light *l = &sc->lights[sc->nlights++];
+            memcpy(l->dir, v, sizeof l->dir);
+            for (int c = 0; c < 3; c++) l->rgb[c] = nt == 5 ? v[3] : v[3 + c];
+            for (int c = 0; c < 3; c++) if (l->rgb[c] < 0) FAIL(HSR_EPARSE, "light intensity must be >= 0");
+            l->line = lineno;
+            if (sc->nlights == 1) {
+                memcpy(sc->light, v, sizeof sc->light);
+                sc->light_i = (l->rgb[0] + l->rgb[1] + l->rgb[2]) / 3;
+            }
         } else if (!strcmp(k, "ambient")) {
             if (nt != 2 || !nums(tok + 1, 1, v)) FAIL(HSR_EPARSE, "'ambient A' needs a finite number");
-            sc->ambient = v[0];
+            sc->ambient = v[0]; sc->ambient_line = lineno;
         } else if (!strcmp(k, "background")) {
+            if (nt == 3 && !strcmp(tok[1], "image")) {
+                if (tok[2][0] == '/' || !dir) snprintf(sc->bg_image, sizeof sc->bg_image, "%s", tok[2]);
+                else snprintf(sc->bg_image, sizeof sc->bg_image, "%s/%s", dir, tok[2]);
+                continue;
+            }
             if (nt != 4 || !nums(tok + 1, 3, v)) FAIL(HSR_EPARSE, "'background R G B' needs 3 numbers");
             memcpy(sc->bg, v, sizeof sc->bg);
         } else if (!strcmp(k, "material")) {
-            if ((nt != 5 && nt != 7) || !nums(tok + 2, 3, v) || (nt == 7 && (strcmp(tok[5], "opacity") || !nums(tok + 6, 1, v + 3))))
-                FAIL(HSR_EPARSE, "expected 'material NAME R G B [opacity A]'");
-            if (nt == 5) v[3] = 1;
-            if (!(v[3] >= 0 && v[3] <= 1)) FAIL(HSR_EPARSE, "opacity must be in [0,1]");
+            /* material NAME R G B [opacity A] [specular KS N] [flat] */
+            if (nt < 5 || !nums(tok + 2, 3, v)) FAIL(HSR_EPARSE, "expected 'material NAME R G B [opacity A] [specular KS N] [flat]'");
+            double op = 1, ks = 0, shin = 1;
+            int flat = 0;
+            for (int i = 5; i < nt;) {
+                if (!strcmp(tok[i], "opacity") && i + 1 < nt && nums(tok + i + 1, 1, &op)) i += 2;
+                else if (!strcmp(tok[i], "specular") && i + 2 < nt && nums(tok + i + 1, 1, &ks) && nums(tok + i + 2, 1, &shin)) i += 3;
+                else if (!strcmp(tok[i], "flat")) { flat = 1; i++; }
+                else FAIL(HSR_EPARSE, "expected 'material NAME R G B [opacity A] [specular KS N] [flat]'");
+            }
+            if (!(op >= 0 && op <= 1)) FAIL(HSR_EPARSE, "opacity must be in [0,1]");
+            if (!(ks >= 0 && shin >= 1)) FAIL(HSR_EPARSE, "specular needs KS >= 0 and N >= 1");
             if (strlen(tok[1]) >= 64) FAIL(HSR_EPARSE, "material name too long");
             if (!scene_grow((void **)&sc->mat, &sc->capmat, sc->nmat + 1, sizeof(hsr_material))) FAIL(HSR_ENOMEM, "out of memory");
             hsr_material *m = &sc->mat[sc->nmat++];
             snprintf(m->name, sizeof m->name, "%s", tok[1]);
-            m->rgb[0] = v[0]; m->rgb[1] = v[1]; m->rgb[2] = v[2]; m->opacity = v[3];
+            m->rgb[0] = v[0]; m->rgb[1] = v[1]; m->rgb[2] = v[2]; m->opacity = op;
+            m->ks = ks; m->shininess = shin; m->flat = flat; m->line = lineno;
         } else if (!strcmp(k, "obj")) {
             if (nt != 2 && !(nt == 4 && !strcmp(tok[2], "material"))) FAIL(HSR_EPARSE, "expected 'obj PATH [material NAME]'");
             int mat = 0;
@@ -139,9 +168,12 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             char *text2;
             hsr_status st = read_file(path, &text2);
             if (st != HSR_OK) FAIL(st, "cannot read OBJ file '%s' (%s)", path, hsr_status_str(st));
+            int nf0 = sc->nf;
             st = hsr_obj_parse(sc, text2, path, mat, err, errlen);
             free(text2);
             if (st != HSR_OK) return st;
+            for (int i = nf0; i < sc->nf; i++) sc->f[i].obj = sc->nobj;
+            sc->nobj++;
         } else FAIL(HSR_EPARSE, "unknown statement '%s'", k);
 #undef FAIL
     }
@@ -164,7 +196,10 @@ hsr_status hsr_scene_load(const char *path, hsr_scene **out, char *err, size_t e
     if (slash) *slash = 0; else snprintf(dir, sizeof dir, ".");
     hsr_scene *sc;
     st = hsr_scene_new(&sc);
-    if (st == HSR_OK) st = hsr_scene_parse(sc, text, path, dir, err, errlen);
+    if (st == HSR_OK) {
+        snprintf(sc->name, sizeof sc->name, "%s", path);
+        st = hsr_scene_parse(sc, text, path, dir, err, errlen);
+    }
     free(text);
     if (st != HSR_OK) { hsr_scene_free(sc); return st; }
     *out = sc;

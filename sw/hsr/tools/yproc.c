@@ -1,18 +1,30 @@
 /* yproc - command-line front end of sw/hsr.
  *   yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]
  *                   [--svg FILE.svg] [--stats]
+ *   yproc scan SCENE -o OUTDIR [--mode M] [--no-aa] [--shading S] [--frames N]
+ *                    [--cmd] [--tol T] [--capacity N] [--expect]
+ *   yproc anim ANIMSCENE -o OUTDIR [scan options] [--full]
+ * (scan / anim: docs/yproc.md)
  * Reads the scene (and its OBJ files), applies viewing and perspective,
  * runs the exact incremental HSR and writes the requested outputs.
  * Errors are printed as "file:line: message"; the exit status is 1. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 #include "hsr.h"
+
+int yproc_scan_main(int argc, char **argv);   /* yproc_scan.c part below */
 
 static int usage(void)
 {
     fprintf(stderr, "usage: yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]"
-                    " [--svg FILE.svg] [--stats]\n");
+                    " [--svg FILE.svg] [--stats]\n"
+                    "       yproc scan SCENE -o OUTDIR [--mode 640x480|640x485|1280x1024] [--no-aa]\n"
+                    "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
+                    "                  [--capacity SLOTS] [--expect]\n"
+                    "       yproc anim ANIMSCENE -o OUTDIR [same options] [--full]\n");
     return 2;
 }
 
@@ -52,6 +64,10 @@ static hsr_status write_input_json(const char *path, const hsr_ctx *h, const hsr
 
 int main(int argc, char **argv)
 {
+    if (argc >= 3 && (!strcmp(argv[1], "scan") || !strcmp(argv[1], "anim"))) {
+        int rc = yproc_scan_main(argc, argv);
+        return rc == 2 ? usage() : rc;
+    }
     if (argc < 3 || strcmp(argv[1], "hsr")) return usage();
     const char *scene = argv[2], *json = NULL, *svg = NULL, *input = NULL;
     int stats = 0;

@@ -1,0 +1,222 @@
+/* yp_emit.c - command lists, their serialisation (Table 7.2 as in
+ * docs/isa.md section 2/3, byte for byte what diffengine's isa.serialise
+ * produces), the .cmd text form, and a small x-processor model of the
+ * commands yp emits (used for the expected frame and the tests). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "yp_internal.h"
+
+#define M36 ((UINT64_C(1) << 36) - 1)
+
+int yp_cmd_slots(const yp_cmd *c)
+{
+    switch (c->op) {
+    case YP_EVAL: return c->order + 3;
+    case YP_SETI: case YP_SETDI: case YP_SETDDI: return 2;
+    default: return 1;
+    }
+}
+
+hsr_status yp_cmdlist_push(yp_cmdlist *l, yp_cmd c)
+{
+    if (l->n == l->cap) {
+        int nc = l->cap ? 2 * l->cap : 16;
+        yp_cmd *p = realloc(l->c, sizeof(yp_cmd) * (size_t)nc);
+        if (!p) return HSR_ENOMEM;
+        l->c = p; l->cap = nc;
+    }
+    l->c[l->n++] = c;
+    l->slots += yp_cmd_slots(&c);
+    return HSR_OK;
+}
+
+void yp_cmdlist_free(yp_cmdlist *l)
+{
+    free(l->c);
+    l->c = NULL; l->n = l->cap = l->slots = 0;
+}
+
+void yp_options_default(yp_options *o)
+{
+    o->capacity = 799; o->aa = 1; o->shading = YP_PHONG; o->tol = 1.0;
+}
+
+int yp_mode_capacity(const char *mode, int *width, int *height)
+{
+    static const struct { const char *name; int w, h, htotal; } modes[] = {
+        {"640x480", 640, 480, 800}, {"640x485", 640, 485, 683}, {"1280x1024", 1280, 1024, 1688}};
+    for (size_t i = 0; i < sizeof modes / sizeof modes[0]; i++)
+        if (!strcmp(mode, modes[i].name)) {
+            if (width) *width = modes[i].w;
+            if (height) *height = modes[i].h;
+            return modes[i].htotal - 1;
+        }
+    return 0;
+}
+
+hsr_status yp_frame_new(int width, int height, yp_frame **out)
+{
+    if (!out || width < 1 || height < 1 || width > 4096) return HSR_EINVAL;
+    yp_frame *f = calloc(1, sizeof *f);
+    if (!f) return HSR_ENOMEM;
+    f->width = width; f->height = height;
+    f->line = calloc(3 * (size_t)height, sizeof(yp_cmdlist));
+    f->st = calloc((size_t)height, sizeof(yp_line_stats));
+    f->ideal = calloc(3 * (size_t)height * (size_t)width, sizeof(double));
+    if (!f->line || !f->st || !f->ideal) { yp_frame_free(f); return HSR_ENOMEM; }
+    *out = f;
+    return HSR_OK;
+}
+
+void yp_frame_free(yp_frame *f)
+{
+    if (!f) return;
+    if (f->line) for (int i = 0; i < 3 * f->height; i++) yp_cmdlist_free(&f->line[i]);
+    free(f->line); free(f->st); free(f->ideal); free(f);
+}
+
+/* ---- x-processor model (docs/isa.md section 6), per line ------------- */
+void yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix)
+{
+    uint64_t *D = calloc((size_t)width, sizeof(uint64_t)), *R = calloc(3 * (size_t)width, sizeof(uint64_t));
+    unsigned char *fl = calloc((size_t)width, 1);   /* bit 0..2 protect A,B,C; 3 dis; 4 lock */
+    if (!D || !R || !fl) { free(D); free(R); free(fl); memset(pix, 0, sizeof(uint16_t) * (size_t)width); return; }
+    int accm = 0;
+    for (int i = 0; i < l->n; i++) {
+        const yp_cmd *c = &l->c[i];
+        int a = c->x, e = c->x + c->dx;
+        if (e > width) e = width;
+        switch (c->op) {
+        case YP_ACCMODE: accm = (int)c->v[0]; break;
+        case YP_DIS: for (int p = a; p < e; p++) fl[p] |= 8; break;
+        case YP_SETI: case YP_SETDI: case YP_SETDDI: {
+            int r = c->op - YP_SETI;
+            for (int p = a; p < e; p++) { R[3 * p + r] = (uint64_t)c->v[0]; fl[p] |= (unsigned char)(1 << r); }
+            break;
+        }
+        case YP_EVAL0:
+            for (int p = a; p < e; p++) {
+                if (!(fl[p] & 0x18)) { D[p] = (uint64_t)c->v[0] << 24; fl[p] |= 16; }
+                fl[p] &= (unsigned char)~0x0f;
+            }
+            break;
+        case YP_EVAL: {
+            /* incoming values highest order first: in[0] = I, in[1] = dI, in[2] = ddI */
+            uint64_t in[3] = {(uint64_t)c->v[0], (uint64_t)c->v[1], (uint64_t)c->v[2]};
+            int ord = c->order;
+            for (int p = a; p < e; p++) {
+                uint64_t v[3];
+                for (int r = ord; r >= 0; r--) v[r] = (fl[p] & (1 << r)) ? R[3 * p + r] : in[r];
+                for (int r = 0; r <= ord; r++) R[3 * p + r] = v[r];
+                uint64_t A = v[0] & M36;
+                int neg = (int)((A >> 35) & 1);
+                if (!(fl[p] & 0x18) && !(accm && neg)) D[p] += A;
+                fl[p] &= (unsigned char)~0x0f;
+                for (int r = 0; r < ord; r++) in[r] = v[r] + v[r + 1];
+                in[ord] = v[ord];
+            }
+            break;
+        }
+        default: break;
+        }
+    }
+    for (int p = 0; p < width; p++) pix[p] = (uint16_t)(((D[p] & M36) >> 24) & 0xfff);
+    free(D); free(R); free(fl);
+}
+
+/* ---- serialisation -------------------------------------------------- */
+static void put48(FILE *f, unsigned ident, uint64_t data)
+{
+    uint64_t w = ((uint64_t)(ident & 0xfff) << 36) | (data & M36);
+    unsigned char b[6];
+    for (int i = 0; i < 6; i++) b[i] = (unsigned char)(w >> (40 - 8 * i));
+    fwrite(b, 1, 6, f);
+}
+
+static void put_cmd(FILE *f, const yp_cmd *c)
+{
+    uint64_t rng = (uint64_t)(c->x & 0xfff) | ((uint64_t)(c->dx & 0xfff) << 12);
+    switch (c->op) {
+    case YP_REFRESH: put48(f, 0x100, 0); break;
+    case YP_ACCMODE: put48(f, c->v[0] ? 0x001 : 0x002, 0); break;
+    case YP_DIS: put48(f, 0x803, rng); break;
+    case YP_EVAL0: put48(f, 0x802, rng | ((uint64_t)(c->v[0] & 0xfff) << 24)); break;
+    case YP_SETI: case YP_SETDI: case YP_SETDDI: {
+        static const unsigned set_id[3] = {0x448, 0x488, 0x4C8};
+        put48(f, 0x800, rng); put48(f, set_id[c->op - YP_SETI], (uint64_t)c->v[0]);
+        break;
+    }
+    case YP_EVAL: {
+        put48(f, 0x800, rng);
+        if (c->order == 0) put48(f, 0x444, (uint64_t)c->v[0]);
+        else if (c->order == 1) { put48(f, 0x484, (uint64_t)c->v[1]); put48(f, 0x464, (uint64_t)c->v[0]); }
+        else { put48(f, 0x4C4, (uint64_t)c->v[2]); put48(f, 0x4B4, (uint64_t)c->v[1]); put48(f, 0x464, (uint64_t)c->v[0]); }
+        put48(f, 0x200, 0);
+        break;
+    }
+    default: break;
+    }
+}
+
+hsr_status yp_write_de48(const yp_frame *fr, int colour, const char *path)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return HSR_EIO;
+    static const unsigned char hdr[8] = {'D', 'E', '4', '8', 0, 1, 0, 0};
+    fwrite(hdr, 1, 8, f);
+    const yp_cmd refresh = {YP_REFRESH, 0, 0, 0, {0, 0, 0}};
+    for (int y = 0; y < fr->height; y++) {
+        const yp_cmdlist *l = &fr->line[colour * fr->height + y];
+        for (int i = 0; i < l->n; i++) put_cmd(f, &l->c[i]);
+        put_cmd(f, &refresh);
+    }
+    return fclose(f) == 0 ? HSR_OK : HSR_EIO;
+}
+
+static void fixed(char *buf, size_t n, int64_t v)
+{
+    uint64_t w = (uint64_t)v & M36;
+    snprintf(buf, n, "0x%03x.%06x", (unsigned)(w >> 24), (unsigned)(w & 0xffffff));
+}
+
+void yp_format_cmd(const yp_cmd *c, char *buf, size_t n)
+{
+    char a[3][24];
+    switch (c->op) {
+    case YP_REFRESH: snprintf(buf, n, "Refresh;"); break;
+    case YP_ACCMODE: snprintf(buf, n, "Acc_mode (%d);", c->v[0] ? 1 : 0); break;
+    case YP_DIS: snprintf(buf, n, "Dis (%u, %u);", c->x, c->dx); break;
+    case YP_EVAL0: snprintf(buf, n, "Eval0 (%u, %u, %u);", c->x, c->dx, (unsigned)c->v[0]); break;
+    case YP_SETI: case YP_SETDI: case YP_SETDDI: {
+        static const char *nm[3] = {"SetI", "SetdI", "SetddI"};
+        fixed(a[0], sizeof a[0], c->v[0]);
+        if (c->dx == 1) snprintf(buf, n, "%s (%u, %s);", nm[c->op - YP_SETI], c->x, a[0]);
+        else snprintf(buf, n, "%s (%u, %u, %s);", nm[c->op - YP_SETI], c->x, c->dx, a[0]);
+        break;
+    }
+    case YP_EVAL:
+        for (int i = 0; i <= c->order; i++) fixed(a[i], sizeof a[i], c->v[i]);
+        if (c->order == 0) snprintf(buf, n, "Eval1 (%u, %u, %s);", c->x, c->dx, a[0]);
+        else if (c->order == 1) snprintf(buf, n, "Eval2 (%u, %u, %s, %s);", c->x, c->dx, a[0], a[1]);
+        else snprintf(buf, n, "Eval3 (%u, %u, %s, %s, %s);", c->x, c->dx, a[0], a[1], a[2]);
+        break;
+    default: snprintf(buf, n, "Nop;"); break;
+    }
+}
+
+hsr_status yp_write_cmd(const yp_frame *fr, int colour, const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return HSR_EIO;
+    fprintf(f, "# yproc: %s stream, %d lines of %d pixels (docs/yproc.md)\n", colour == 0 ? "red" : colour == 1 ? "green" : "blue",
+            fr->height, fr->width);
+    char buf[160];
+    for (int y = 0; y < fr->height; y++) {
+        const yp_cmdlist *l = &fr->line[colour * fr->height + y];
+        fprintf(f, "# line %d\n", y);
+        for (int i = 0; i < l->n; i++) { yp_format_cmd(&l->c[i], buf, sizeof buf); fprintf(f, "%s\n", buf); }
+        fprintf(f, "Refresh;\n");
+    }
+    return fclose(f) == 0 ? HSR_OK : HSR_EIO;
+}

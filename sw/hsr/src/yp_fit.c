@@ -1,0 +1,100 @@
+/* yp_fit.c - a colour function along a span as one Eval of order p
+ * (Eval1 / Eval2 / Eval3) whose highest difference is replaced at knots by
+ * SetI / SetdI / SetddI (docs/yproc.md "Piecewise fit").
+ *
+ * The array evaluates, from the Eval's first column on, the forward
+ * differences of its operands; a Set of the highest difference at column
+ * k replaces it from k on while the lower ones continue: a spline of
+ * degree p on the integer grid, C^(p-1) at the knots, each knot 2 slots.
+ * Greedy, one pass: with the lower differences at a segment start k fixed,
+ * the value at k + t is linear in the segment's highest difference c
+ * (coefficient binom(t, p)), so each constrained pixel t >= p restricts c
+ * to an interval.  The segment ends at the first pixel e where the
+ * intersection becomes empty; c is the integer in the middle of the last
+ * non-empty intersection (the test is exact 12.24 arithmetic), and the next
+ * knot is at e - p, the last column whose outputs c still decides.  So
+ * every constrained pixel lies within tol of its target by construction;
+ * the result is re-checked by forward differencing before it is used.
+ * clamp: Acc_mode is on, a value < 0 contributes 0, so where the target
+ * is <= tol any value <= target + tol is good. */
+#include <math.h>
+#include <stdlib.h>
+#include "yp_internal.h"
+
+void yp_eval_values(int order, const int64_t *v0, int n, const int *knot_pos,
+                    const int64_t *knot_c, int nk, int64_t *val)
+{
+    uint64_t v[3] = {(uint64_t)v0[0], (uint64_t)v0[1], (uint64_t)v0[2]};
+    int k = 0;
+    for (int t = 0; t < n; t++) {
+        while (k < nk && knot_pos[k] == t) v[order] = (uint64_t)knot_c[k++];
+        val[t] = (int64_t)v[0];
+        for (int r = 0; r < order; r++) v[r] += v[r + 1];
+    }
+}
+
+static int ok_at(double v, double f, double tol, int clamp)
+{
+    if (clamp && f <= tol && v <= 0) return 1;
+    return fabs(v - f) <= tol;
+}
+
+static double binom(int t, int p) { return p == 0 ? 1 : p == 1 ? t : 0.5 * t * (t - 1); }
+
+int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, double tol,
+           int clamp, yp_cmdlist *out)
+{
+    if (n <= 0 || order < 0 || order > 2) return -1;
+    const double S = YP_ONE, T = tol * S * (1 - 1e-9);
+    int *kp = malloc(sizeof(int) * (size_t)(n + 1));
+    int64_t *kc = malloc(sizeof(int64_t) * (size_t)(n + 1));
+    int64_t *val = malloc(sizeof(int64_t) * (size_t)n);
+    if (!kp || !kc || !val) { free(kp); free(kc); free(val); return -1; }
+    /* start: exact at the first pixel, slope to the next constrained one */
+    int j = 1;
+    while (j < n && !use[j]) j++;
+    int64_t v0[3] = {llround(f[0] * S), 0, 0};
+    if (order == 2 && j < n) v0[1] = llround((f[j] - f[0]) / j * S);
+    int64_t v[3] = {v0[0], v0[1], 0};          /* differences at segment start k */
+    int nk = 0, k = 0;
+    for (;;) {
+        double lo = -INFINITY, hi = INFINITY;
+        int e = n;
+        for (int t = order; k + t < n; t++) {
+            int x = k + t;
+            if (!use[x]) continue;
+            double B = binom(t, order), base = 0;
+            for (int r = 0; r < order; r++) base += (double)v[r] * binom(t, r);
+            double tgt = f[x] * S, flo = (clamp && f[x] <= tol) ? -INFINITY : tgt - T, fhi = tgt + T;
+            double nlo = ceil((flo - base) / B), nhi = floor((fhi - base) / B);
+            if (nlo < lo) nlo = lo;
+            if (nhi > hi) nhi = hi;
+            if (nlo > nhi) { e = x; break; }
+            lo = nlo; hi = nhi;
+        }
+        double c = isfinite(lo) && isfinite(hi) ? floor(0.5 * (lo + hi))
+                 : isfinite(lo) ? lo : isfinite(hi) ? hi : 0;
+        if (nk == 0) v0[order] = (int64_t)c; else kc[nk - 1] = (int64_t)c;
+        v[order] = (int64_t)c;
+        if (e >= n) break;
+        int knot = e - order;
+        if (knot <= k) knot = k + 1;    /* cannot happen for tol >= 2^-24; the check below would fail */
+        for (int x = k; x < knot; x++)
+            for (int r = 0; r < order; r++) v[r] = (int64_t)((uint64_t)v[r] + (uint64_t)v[r + 1]);
+        kp[nk++] = knot;
+        k = knot;
+    }
+    yp_eval_values(order, v0, n, kp, kc, nk, val);
+    int bad = 0;
+    for (int x = 0; x < n && !bad; x++)
+        if (use[x] && !ok_at((double)val[x] / S, f[x], tol, clamp)) bad = 1;
+    hsr_status st = HSR_OK;
+    for (int i = 0; i < nk && st == HSR_OK; i++) {
+        yp_cmd s = {(uint8_t)(YP_SETI + order), 0, (uint16_t)(x0 + kp[i]), 1, {kc[i], 0, 0}};
+        st = yp_cmdlist_push(out, s);
+    }
+    yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {v0[0], v0[1], v0[2]}};
+    if (st == HSR_OK) st = yp_cmdlist_push(out, ev);
+    free(kp); free(kc); free(val);
+    return bad || st != HSR_OK ? -1 : nk;
+}

@@ -1,0 +1,44 @@
+/* yp_internal.h - private types of the y-processor (yp_*.c). */
+#ifndef YP_INTERNAL_H
+#define YP_INTERNAL_H
+#include "internal.h"
+
+#define YP_PIX 4095.0                 /* intensity 1.0 in pixel units */
+#define YP_ONE ((double)(1 << 24))    /* 1 pixel unit in 12.24 */
+
+struct yp_shader {
+    const hsr_scene *sc;
+    yp_shading mode;
+    scene_view vw;
+    double *vn;          /* 3 per vertex: smooth normal (unit) */
+    double *fn;          /* 3 per face: unit face normal (Newell), 0 if degenerate */
+    double *flat;        /* 3 per face: flat colour, pixel units (flat mode) */
+    double *gour;        /* 15 per face: I = a x + b y + c per colour, then min, max (gouraud) */
+    int nl;
+    double L[HSR_MAX_LIGHTS][3], Lrgb[HSR_MAX_LIGHTS][3];
+    double bg[3];        /* pixel units */
+};
+
+/* Colour of face fi at pixel position (px, py) (pixel coordinates, y
+ * down), pixel units: base = ambient + diffuse (+ specular unless Phong
+ * mode), spec[3*l + c] = specular of light l (Phong mode; else 0). */
+void yp_shade_face(const yp_shader *s, int fi, double px, double py, double base[3], double *spec);
+
+/* yp_cover.c: signed-area accumulation of a closed ring set (pixel
+ * coordinates relative to the buffer origin) into acc (ny rows of
+ * stride nx + 2); coverage = |prefix sum along a row|. */
+void yp_cover_ring(const double *xy, int n, double *acc, int nx, int ny);
+
+/* yp_fit.c: spline of degree order (0..2) evaluated by one Eval of that
+ * order with Set knots.  f[0..n-1] target (pixel units), use[i] = 0:
+ * don't care (use[0] must be 1).  clamp: Acc_mode is on (values that go
+ * negative count as 0).  Appends the Sets and the Eval for the span
+ * starting at column x0 to out (Sets first); returns knots or -1. */
+int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, double tol,
+           int clamp, yp_cmdlist *out);
+/* forward differencing of an order-p Eval with knots (value per column) */
+void yp_eval_values(int order, const int64_t *v0, int n, const int *knot_pos,
+                    const int64_t *knot_c, int nk, int64_t *val);
+void yp_format_cmd(const yp_cmd *c, char *buf, size_t n);   /* yp_emit.c: .cmd text */
+
+#endif

@@ -1,0 +1,391 @@
+/* yp_scan.c - the y-processor's per-frame work (sections 7.2, 7.3, 5.5):
+ * for every visible pattern and every scanline it touches, the terms of
+ * eq. 7.2 as x-processor commands; capacity per line with degradation
+ * Eval3 -> Eval2 -> Eval1 of the least visible patterns (section 7.5).
+ *
+ * A pattern is the visible part of one layer stack: all LLR domains with
+ * the same ordered parent prefix are scan-converted together, so the
+ * commands do not depend on how the HSR fragmented the visibility map
+ * (an incremental update then gives the same streams as a full rebuild).
+ *
+ * Every line starts with Eval1 (0, W, background + 1/2): the background
+ * where nothing is visible, and the 1/2 makes the pixel (the integer part
+ * of D) the rounded sum.  A pattern adds cov * (colour - background) per
+ * pixel, so a pixel shared by domains gets exactly the box-filter average
+ * (eq. 5.6) and a fully covered pixel the pattern's colour:
+ *   - pixels it covers fully: one Eval over the span from its first to its
+ *     last full pixel, Dis over the pixels in between that are not full
+ *     (1 slot each, cheaper than splitting the Eval: 3..5 slots);
+ *   - pixels it covers partly: Eval1 (x, 1, cov * (colour - background)).
+ * Specular terms of Phong patterns come last, after Acc_mode (1): they
+ * are >= 0, so a fitted quadratic that dips below 0 contributes 0. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "yp_internal.h"
+
+#define COV_Q 65536.0     /* coverage is rounded to 1/65536 of a pixel */
+
+typedef struct entry {
+    double area;
+    int maxlev, lev;
+    int cost[4];               /* slots of levels 1..3 (without partial pixels) */
+    int spec_cost;             /* part of cost[3] after Acc_mode */
+    int npart;
+    yp_cmdlist lv[4], spec;    /* lv[1..3]: Dis + Sets + Eval over the covered pixels */
+} entry;
+
+typedef struct line_entries { entry **e; int n, cap; } line_entries;
+
+typedef struct key { int slot; const int *par; int nvis; } key;
+
+static int key_cmp(const void *pa, const void *pb)
+{
+    const key *a = pa, *b = pb;
+    int n = a->nvis < b->nvis ? a->nvis : b->nvis;
+    for (int i = 0; i < n; i++) if (a->par[i] != b->par[i]) return a->par[i] < b->par[i] ? -1 : 1;
+    if (a->nvis != b->nvis) return a->nvis < b->nvis ? -1 : 1;
+    return a->slot < b->slot ? -1 : a->slot > b->slot;
+}
+
+static void entry_free(entry *e)
+{
+    if (!e) return;
+    yp_cmdlist_free(&e->spec);
+    for (int i = 0; i < 4; i++) yp_cmdlist_free(&e->lv[i]);
+    free(e);
+}
+
+typedef struct scan {
+    const yp_shader *sh;
+    const yp_options *o;
+    yp_frame *fr;
+    int W, H, y0, y1, nl;
+    line_entries *le;          /* [y1 - y0][3] */
+    /* scratch */
+    double *fb, *fs, *ft, *cov;  /* per column: base, spec (nl), total; coverage */
+    unsigned char *use, *use2;
+    double *tmp;
+} scan;
+
+/* Dis over the runs of [a, b) where in[x - off] == 0 */
+static hsr_status push_dis(yp_cmdlist *l, const unsigned char *in, int a, int b, int off)
+{
+    for (int x = a; x < b;) {
+        if (in[x - off]) { x++; continue; }
+        int g = x;
+        while (x < b && !in[x - off]) x++;
+        yp_cmd d = {YP_DIS, 0, (uint16_t)g, (uint16_t)(x - g), {0, 0, 0}};
+        hsr_status st = yp_cmdlist_push(l, d);
+        if (st != HSR_OK) return st;
+    }
+    return HSR_OK;
+}
+
+static int64_t q24(double v) { return llround(v * YP_ONE); }
+
+/* one pattern on one row: layers par[0..nvis-1], coverage cov[x0..x1) */
+static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const double *cov, int x0, int x1)
+{
+    const yp_shader *sh = s->sh;
+    const hsr_scene *sc = sh->sc;
+    const yp_options *o = s->o;
+    int nl = s->nl, npart = 0;
+    double area = 0;
+    unsigned char *full = s->use;   /* indexed by absolute column */
+    for (int x = x0; x < x1; x++) {
+        double c = cov[x - x0];
+        full[x] = c >= 1.0;
+        if (c <= 0) continue;
+        area += c;
+        if (!full[x]) npart++;
+    }
+    if (area <= 0) return HSR_OK;
+    /* colour functions at the pixel centres of [x0, x1) */
+    double w[HSR_MAX_PREFIX + 1], rem = 1;
+    for (int j = 0; j < nvis; j++) {
+        double op = sc->mat[sc->f[par[j]].material].opacity;
+        if (op > 1) op = 1;
+        w[j] = (j == nvis - 1 && op >= 1) ? rem : rem * op;
+        rem -= w[j];
+    }
+    double base[3], spec[3 * HSR_MAX_LIGHTS];
+    for (int x = x0; x < x1; x++) {
+        if (cov[x - x0] <= 0) continue;
+        double *fb = &s->fb[3 * x], *fs = &s->fs[3 * nl * x];
+        for (int c = 0; c < 3; c++) fb[c] = 0;
+        for (int i = 0; i < 3 * nl; i++) fs[i] = 0;
+        for (int j = 0; j < nvis; j++) {
+            yp_shade_face(sh, par[j], x + 0.5, y + 0.5, base, spec);
+            for (int c = 0; c < 3; c++) fb[c] += w[j] * (base[c] - sh->bg[c]);
+            for (int i = 0; i < 3 * nl; i++) fs[i] += w[j] * spec[i];
+        }
+        for (int c = 0; c < 3; c++) {
+            double t = fb[c];
+            for (int l = 0; l < nl; l++) t += fs[3 * l + c];
+            s->ft[3 * x + c] = t;
+            s->fr->ideal[((size_t)c * s->H + y) * s->W + x] += cov[x - x0] * t;
+        }
+    }
+    line_entries *le = &s->le[3 * (y - s->y0)];
+    int cf = -1, cl = -1;
+    for (int x = x0; x < x1; x++) if (cov[x - x0] > 0) { if (cf < 0) cf = x; cl = x; }
+    const int a = cf, n = cl + 1 - cf;
+    unsigned char *cv = s->use2 + s->W;         /* covered, relative to a */
+    for (int x = a; x <= cl; x++) cv[x - a] = cov[x - x0] > 0;
+    for (int c = 0; c < 3; c++) {
+        entry *e = calloc(1, sizeof *e);
+        if (!e) return HSR_ENOMEM;
+        line_entries *L = &le[c];
+        if (L->n == L->cap) {
+            int nc = L->cap ? 2 * L->cap : 32;
+            entry **p = realloc(L->e, sizeof(entry *) * (size_t)nc);
+            if (!p) { free(e); return HSR_ENOMEM; }
+            L->e = p; L->cap = nc;
+        }
+        L->e[L->n++] = e;
+        e->area = area; e->npart = npart;
+        e->maxlev = o->shading == YP_FLAT ? 1 : o->shading == YP_GOURAUD ? 2 : 3;
+        /* separate specular terms (level 3): lights whose highlight on the
+         * fully covered pixels exceeds the tolerance */
+        int sep[HSR_MAX_LIGHTS], nsep = 0;
+        for (int l = 0; l < nl; l++) {
+            double mx = 0;
+            if (e->maxlev == 3)
+                for (int x = a; x <= cl; x++) if (full[x] && s->fs[3 * nl * x + 3 * l + c] > mx) mx = s->fs[3 * nl * x + 3 * l + c];
+            sep[l] = mx > o->tol;
+            nsep += sep[l];
+        }
+        double *f = s->tmp;
+        hsr_status st = HSR_OK;
+        for (int lev = 1; lev <= e->maxlev && st == HSR_OK; lev++) {
+            /* target: cov * colour over the covered pixels (Dis elsewhere) */
+            for (int x = a; x <= cl; x++) {
+                double cvx = cov[x - x0], v = 0;
+                if (cvx > 0) {
+                    v = s->ft[3 * x + c];
+                    if (lev == 3 && full[x]) for (int l = 0; l < nl; l++) if (sep[l]) v -= s->fs[3 * nl * x + 3 * l + c];
+                    v *= cvx;
+                }
+                f[x - a] = v;
+            }
+            double tol = o->tol * (e->maxlev == lev ? 1 : e->maxlev - lev == 1 ? 4 : 16);
+            st = push_dis(&e->lv[lev], cv, a, a + n, a);
+            if (st == HSR_OK && yp_fit(f, cv, n, a, lev - 1, tol, 0, &e->lv[lev]) < 0) st = HSR_ELIMIT;
+            e->cost[lev] = e->lv[lev].slots;
+        }
+        for (int l = 0; l < nl && st == HSR_OK && nsep; l++) {
+            if (!sep[l]) continue;
+            int sa = -1, sb = -1;
+            unsigned char *use = s->use2;
+            for (int x = a; x <= cl; x++)
+                if (full[x] && s->fs[3 * nl * x + 3 * l + c] > o->tol) { if (sa < 0) sa = x; sb = x; }
+            for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
+            st = push_dis(&e->spec, use, sa, sb + 1, sa);
+            if (st == HSR_OK && yp_fit(f, use, sb + 1 - sa, sa, 2, o->tol, 1, &e->spec) < 0) st = HSR_ELIMIT;
+        }
+        if (st != HSR_OK) return st;
+        e->spec_cost = e->spec.slots;
+        if (e->maxlev == 3) e->cost[3] += e->spec.slots;
+        e->lev = e->maxlev;
+    }
+    return HSR_OK;
+}
+
+static int ent_area_cmp(const void *pa, const void *pb)
+{
+    const entry *a = *(entry *const *)pa, *b = *(entry *const *)pb;
+    return a->area < b->area ? -1 : a->area > b->area;
+}
+
+static int line_cost(entry **e, int n, int *spec)
+{
+    int t = 3, sp = 0;
+    for (int i = 0; i < n; i++) {
+        t += e[i]->cost[e[i]->lev];
+        if (e[i]->lev == 3 && e[i]->spec_cost) sp = 1;
+    }
+    if (spec) *spec = sp;
+    return t + sp;
+}
+
+static hsr_status append(yp_cmdlist *dst, const yp_cmdlist *src)
+{
+    for (int i = 0; i < src->n; i++) {
+        hsr_status st = yp_cmdlist_push(dst, src->c[i]);
+        if (st != HSR_OK) return st;
+    }
+    return HSR_OK;
+}
+
+/* degrade and emit line y, colour c */
+static hsr_status finish_line(scan *s, int y, int c)
+{
+    line_entries *L = &s->le[3 * (y - s->y0) + c];
+    yp_line_stats *ls = &s->fr->st[y];
+    int n = L->n, sp;
+    entry **ord = malloc(sizeof(entry *) * (size_t)(n + 1));
+    if (!ord) return HSR_ENOMEM;
+    memcpy(ord, L->e, sizeof(entry *) * (size_t)n);
+    qsort(ord, (size_t)n, sizeof(entry *), ent_area_cmp);
+    /* section 7.5: lower the colour function of the least visible
+     * patterns first, Eval3 -> Eval2 for all, then Eval2 -> Eval1 */
+    for (int lev = 3; lev >= 2 && line_cost(L->e, n, NULL) > s->o->capacity; lev--)
+        for (int i = 0; i < n && line_cost(L->e, n, NULL) > s->o->capacity; i++)
+            if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) ord[i]->lev = lev - 1;
+    free(ord);
+    int cost = line_cost(L->e, n, &sp);
+    ls->degraded[c] = 0;
+    for (int i = 0; i < n; i++) if (L->e[i]->lev < L->e[i]->maxlev) ls->degraded[c]++;
+    ls->overflow[c] = cost > s->o->capacity;
+    yp_cmdlist *out = &s->fr->line[c * s->H + y];
+    yp_cmdlist_free(out);
+    yp_cmd bg = {YP_EVAL, 0, 0, (uint16_t)s->W, {q24(s->sh->bg[c] + 0.5), 0, 0}};
+    hsr_status st = yp_cmdlist_push(out, bg);
+    for (int i = 0; i < n && st == HSR_OK; i++) {
+        st = append(out, &L->e[i]->lv[L->e[i]->lev]);
+    }
+    if (sp && st == HSR_OK) {
+        yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}};
+        st = yp_cmdlist_push(out, am);
+        for (int i = 0; i < n && st == HSR_OK; i++)
+            if (L->e[i]->lev == 3) st = append(out, &L->e[i]->spec);
+    }
+    ls->cmds[c] = out->n; ls->slots[c] = out->slots;
+    if (c == 0) {
+        ls->patterns = n; ls->partial = 0;
+        for (int i = 0; i < n; i++) ls->partial += L->e[i]->npart;
+    }
+    return st;
+}
+
+static void count_frame(yp_frame *fr)
+{
+    memset(fr->n_eval, 0, sizeof fr->n_eval);
+    fr->n_knots = fr->n_dis = fr->n_partial = fr->n_spec = 0;
+    for (int i = 0; i < 3 * fr->height; i++) {
+        const yp_cmdlist *l = &fr->line[i];
+        int after = 0;
+        for (int k = 0; k < l->n; k++) {
+            const yp_cmd *c = &l->c[k];
+            if (c->op == YP_EVAL) { fr->n_eval[c->order + 1]++; if (after) fr->n_spec++; }
+            else if (c->op == YP_EVAL0) fr->n_eval[0]++;
+            else if (c->op == YP_SETDDI) fr->n_knots++;
+            else if (c->op == YP_DIS) fr->n_dis++;
+            else if (c->op == YP_ACCMODE) after = 1;
+        }
+    }
+    for (int y = 0; y < fr->height; y++) fr->n_partial += 3 * fr->st[y].partial;
+}
+
+hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, int y0, int y1, yp_frame *fr)
+{
+    if (!sh || !h || !o || !fr || fr->width != sh->sc->width || fr->height != sh->sc->height) return HSR_EINVAL;
+    if (y0 < 0) y0 = 0;
+    if (y1 > fr->height) y1 = fr->height;
+    if (y0 >= y1) return HSR_OK;
+    scan s = {sh, o, fr, fr->width, fr->height, y0, y1, sh->nl, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+    const int W = s.W;
+    const double U = HSR_SUBPIXEL;
+    hsr_status st = HSR_OK;
+    int nslots = hsr_llr_slots(h), nk = 0;
+    key *keys = malloc(sizeof(key) * (size_t)(nslots + 1));
+    s.le = calloc(3 * (size_t)(y1 - y0), sizeof(line_entries));
+    s.fb = malloc(sizeof(double) * 3 * (size_t)W);
+    s.fs = malloc(sizeof(double) * 3 * (size_t)(s.nl + 1) * (size_t)W);
+    s.ft = malloc(sizeof(double) * 3 * (size_t)W);
+    s.tmp = malloc(sizeof(double) * (size_t)W);
+    s.use = malloc((size_t)W + 1); s.use2 = malloc(2 * (size_t)W + 2);
+    double *acc = NULL;
+    size_t acccap = 0;
+    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.tmp || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
+    for (int y = y0; y < y1; y++)
+        for (int c = 0; c < 3; c++)
+            for (int x = 0; x < W; x++) fr->ideal[((size_t)c * s.H + y) * W + x] = sh->bg[c];
+    for (int sl = 0; sl < nslots; sl++) {
+        const int *par; int nvis;
+        if (hsr_llr_get(h, sl, NULL, &par, &nvis, NULL)) { keys[nk].slot = sl; keys[nk].par = par; keys[nk].nvis = nvis; nk++; }
+    }
+    qsort(keys, (size_t)nk, sizeof(key), key_cmp);
+    for (int g = 0; g < nk && st == HSR_OK;) {
+        int ge = g + 1;
+        while (ge < nk && keys[ge].nvis == keys[g].nvis && !memcmp(keys[ge].par, keys[g].par, sizeof(int) * (size_t)keys[g].nvis)) ge++;
+        /* pixel box of the group, clipped to the lines asked for */
+        int64_t l = INT64_MAX, b = INT64_MAX, r = INT64_MIN, t = INT64_MIN;
+        for (int i = g; i < ge; i++) {
+            const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
+            hsr_extent e = hsr_domain_extent(d);
+            if (e.left < l) l = e.left;
+            if (e.bot < b) b = e.bot;
+            if (e.right > r) r = e.right;
+            if (e.top > t) t = e.top;
+        }
+        int gx0 = (int)floor(l / U), gx1 = (int)ceil(r / U), gy0 = (int)floor(b / U), gy1 = (int)ceil(t / U);
+        if (gx0 < 0) gx0 = 0;
+        if (gx1 > W) gx1 = W;
+        int ry0 = gy0 > y0 ? gy0 : y0, ry1 = gy1 < y1 ? gy1 : y1;
+        if (gy0 < 0) gy0 = 0;
+        if (gx0 >= gx1 || ry0 >= ry1) { g = ge; continue; }
+        int nx = gx1 - gx0, ny = gy1 - gy0;
+        size_t need = (size_t)ny * (size_t)(nx + 2);
+        if (need > acccap) {
+            double *p = realloc(acc, sizeof(double) * need);
+            if (!p) { st = HSR_ENOMEM; break; }
+            acc = p; acccap = need;
+        }
+        memset(acc, 0, sizeof(double) * need);
+        if (o->aa) {
+            for (int i = g; i < ge && st == HSR_OK; i++) {
+                const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
+                double *xy = NULL; int *len = NULL, nr = 0;
+                st = hsr_domain_rings(d, &xy, &len, &nr);
+                if (st != HSR_OK) break;
+                for (int rr = 0, off = 0; rr < nr; off += len[rr], rr++) {
+                    for (int k = 0; k < len[rr]; k++) {
+                        xy[2 * (off + k)] = xy[2 * (off + k)] / U - gx0;
+                        xy[2 * (off + k) + 1] = xy[2 * (off + k) + 1] / U - gy0;
+                    }
+                    yp_cover_ring(xy + 2 * off, len[rr], acc, nx, ny);
+                }
+                free(xy); free(len);
+            }
+            /* orientation: outer rings have positive area; fix the sign */
+            double sg = 0;
+            for (int yy = 0; yy < ny; yy++) { double run = 0; for (int x = 0; x < nx; x++) { run += acc[(size_t)yy * (nx + 2) + x]; sg += run; } }
+            sg = sg < 0 ? -1 : 1;
+            for (int yy = 0; yy < ny; yy++) {
+                double run = 0, *row = &acc[(size_t)yy * (nx + 2)];
+                for (int x = 0; x < nx; x++) {
+                    run += row[x];
+                    double cv = round(sg * run * COV_Q) / COV_Q;
+                    row[x] = cv < 0 ? 0 : cv > 1 ? 1 : cv;
+                }
+            }
+        } else {
+            for (int yy = ry0 - gy0; yy < ry1 - gy0; yy++)
+                for (int x = 0; x < nx; x++) {
+                    int64_t px = (int64_t)(gx0 + x) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
+                    int64_t py = (int64_t)(gy0 + yy) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
+                    for (int i = g; i < ge; i++) {
+                        const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
+                        if (hsr_domain_contains(d, px, py)) { acc[(size_t)yy * (nx + 2) + x] = 1; break; }
+                    }
+                }
+        }
+        for (int y = ry0; y < ry1 && st == HSR_OK; y++)
+            st = row_entry(&s, keys[g].par, keys[g].nvis, y, &acc[(size_t)(y - gy0) * (nx + 2)], gx0, gx1);
+        g = ge;
+    }
+    for (int y = y0; y < y1 && st == HSR_OK; y++)
+        for (int c = 0; c < 3 && st == HSR_OK; c++) st = finish_line(&s, y, c);
+    if (st == HSR_OK) count_frame(fr);
+done:
+    if (s.le) {
+        for (int i = 0; i < 3 * (y1 - y0); i++) {
+            for (int k = 0; k < s.le[i].n; k++) entry_free(s.le[i].e[k]);
+            free(s.le[i].e);
+        }
+    }
+    free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.use); free(s.use2);
+    return st;
+}

@@ -1,0 +1,243 @@
+/* yp_shade.c - the shading model of docs/shading.md: smooth vertex
+ * normals, directional lights, Phong illumination (eq. 6.1.a with the
+ * surface coefficients of Foley 90), two-sided, local viewer; and the
+ * flat / Gouraud colour functions.  Values are in pixel units (4095 = 1). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "yp_internal.h"
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static int unit3(double *a)
+{
+    double l = sqrt(dot3(a, a));
+    if (!(l > 0) || !isfinite(l)) return 0;
+    a[0] /= l; a[1] /= l; a[2] /= l;
+    return 1;
+}
+
+static const double *vtx(const hsr_scene *sc, int fi, int k)
+{
+    return &sc->v[3 * sc->fv[sc->f[fi].first + k]];
+}
+
+/* unnormalised Newell normal (length = twice the area) */
+static void newell(const hsr_scene *sc, int fi, double *n)
+{
+    int c = sc->f[fi].count;
+    n[0] = n[1] = n[2] = 0;
+    for (int i = 0; i < c; i++) {
+        const double *p = vtx(sc, fi, i), *r = vtx(sc, fi, (i + 1) % c);
+        n[0] += (p[1] - r[1]) * (p[2] + r[2]);
+        n[1] += (p[2] - r[2]) * (p[0] + r[0]);
+        n[2] += (p[0] - r[0]) * (p[1] + r[1]);
+    }
+}
+
+/* Phong at world point P with normal N (any length) for material m. */
+static void phong(const yp_shader *s, const hsr_material *m, const double *P, const double *Nin,
+                  double base[3], double *spec, int split)
+{
+    double N[3] = {Nin[0], Nin[1], Nin[2]}, E[3];
+    for (int k = 0; k < 3; k++) E[k] = s->sc->eye[k] - P[k];
+    unit3(E);
+    if (!unit3(N)) { N[0] = E[0]; N[1] = E[1]; N[2] = E[2]; }
+    if (dot3(N, E) < 0) { N[0] = -N[0]; N[1] = -N[1]; N[2] = -N[2]; }   /* two-sided */
+    for (int c = 0; c < 3; c++) base[c] = s->sc->ambient * m->rgb[c];
+    for (int l = 0; l < s->nl; l++) {
+        const double *L = s->L[l];
+        double nl = dot3(N, L), d = nl > 0 ? nl : 0, sp = 0;
+        if (m->ks > 0) {
+            double R[3] = {2 * nl * N[0] - L[0], 2 * nl * N[1] - L[1], 2 * nl * N[2] - L[2]};
+            double er = dot3(E, R);
+            sp = er > 0 ? m->ks * pow(er, m->shininess) : 0;
+        }
+        for (int c = 0; c < 3; c++) {
+            base[c] += s->Lrgb[l][c] * m->rgb[c] * d;
+            double v = s->Lrgb[l][c] * sp * YP_PIX;
+            if (split) spec[3 * l + c] = v; else base[c] += v / YP_PIX;
+        }
+    }
+    for (int c = 0; c < 3; c++) base[c] *= YP_PIX;
+}
+
+/* barycentric weights of world point P in triangle (a, b, c) */
+static void bary(const double *a, const double *b, const double *c, const double *P, double *w)
+{
+    double e0[3], e1[3], ep[3];
+    for (int k = 0; k < 3; k++) { e0[k] = b[k] - a[k]; e1[k] = c[k] - a[k]; ep[k] = P[k] - a[k]; }
+    double d00 = dot3(e0, e0), d01 = dot3(e0, e1), d11 = dot3(e1, e1), dp0 = dot3(ep, e0), dp1 = dot3(ep, e1);
+    double den = d00 * d11 - d01 * d01;
+    if (!(fabs(den) > 0)) { w[0] = 1; w[1] = w[2] = 0; return; }
+    w[1] = (d11 * dp0 - d01 * dp1) / den;
+    w[2] = (d00 * dp1 - d01 * dp0) / den;
+    w[0] = 1 - w[1] - w[2];
+}
+
+static void face_point_normal(const yp_shader *s, int fi, const double *P, double *N)
+{
+    const hsr_scene *sc = s->sc;
+    const hsr_face *F = &sc->f[fi];
+    if (sc->mat[F->material].flat) { memcpy(N, &s->fn[3 * fi], 3 * sizeof(double)); return; }
+    /* n-gons: the fan triangle (0, i, i+1) in which P lies best */
+    double best = -1e300, bw[3] = {1, 0, 0};
+    int bi = 1;
+    for (int i = 1; i + 1 < F->count; i++) {
+        double w[3];
+        bary(vtx(sc, fi, 0), vtx(sc, fi, i), vtx(sc, fi, i + 1), P, w);
+        double mn = fmin(w[0], fmin(w[1], w[2]));
+        if (mn > best) { best = mn; bi = i; memcpy(bw, w, sizeof bw); }
+    }
+    const int *fv = &sc->fv[F->first];
+    for (int k = 0; k < 3; k++)
+        N[k] = bw[0] * s->vn[3 * fv[0] + k] + bw[1] * s->vn[3 * fv[bi] + k] + bw[2] * s->vn[3 * fv[bi + 1] + k];
+}
+
+static void centroid(const hsr_scene *sc, int fi, double *P)
+{
+    int c = sc->f[fi].count;
+    P[0] = P[1] = P[2] = 0;
+    for (int i = 0; i < c; i++) for (int k = 0; k < 3; k++) P[k] += vtx(sc, fi, i)[k] / c;
+}
+
+void yp_shade_face(const yp_shader *s, int fi, double px, double py, double base[3], double *spec)
+{
+    const hsr_scene *sc = s->sc;
+    if (spec) for (int i = 0; i < 3 * s->nl; i++) spec[i] = 0;
+    if (s->mode == YP_FLAT) { memcpy(base, &s->flat[3 * fi], 3 * sizeof(double)); return; }
+    if (s->mode == YP_GOURAUD) {
+        for (int c = 0; c < 3; c++) {
+            const double *g = &s->gour[15 * fi + 3 * c], *mm = &s->gour[15 * fi + 9 + 2 * c];
+            base[c] = fmin(mm[1], fmax(mm[0], g[0] * px + g[1] * py + g[2]));   /* no extrapolation */
+        }
+        return;
+    }
+    /* ray through the pixel position, intersected with the face's plane */
+    const scene_view *vw = &s->vw;
+    double a = (px - vw->W / 2) / vw->f, b = (vw->H / 2 - py) / vw->f, dir[3], P[3];
+    for (int k = 0; k < 3; k++) dir[k] = a * vw->u[k] + b * vw->v[k] - vw->w[k];
+    const double *n = &s->fn[3 * fi], *p0 = vtx(sc, fi, 0);
+    double den = dot3(n, dir);
+    if (fabs(den) > 1e-12) {
+        double d0[3] = {p0[0] - sc->eye[0], p0[1] - sc->eye[1], p0[2] - sc->eye[2]};
+        double t = dot3(n, d0) / den;
+        for (int k = 0; k < 3; k++) P[k] = sc->eye[k] + t * dir[k];
+    } else centroid(sc, fi, P);
+    double N[3];
+    face_point_normal(s, fi, P, N);
+    phong(s, &sc->mat[sc->f[fi].material], P, N, base, spec, 1);
+}
+
+/* flat colour (Phong at the centroid with the face normal) and the
+ * Gouraud plane (Phong at the vertices, affine in screen space) */
+static void face_functions(yp_shader *s, int fi)
+{
+    const hsr_scene *sc = s->sc;
+    const hsr_material *m = &sc->mat[sc->f[fi].material];
+    double P[3], base[3];
+    centroid(sc, fi, P);
+    phong(s, m, P, &s->fn[3 * fi], base, NULL, 0);
+    memcpy(&s->flat[3 * fi], base, sizeof base);
+    double *g = &s->gour[15 * fi];
+    for (int c = 0; c < 3; c++) { g[3 * c] = g[3 * c + 1] = 0; g[3 * c + 2] = base[c]; g[9 + 2 * c] = g[10 + 2 * c] = base[c]; }
+    if (sc->f[fi].count < 3) return;
+    double xs[3], ys[3], I[3][3];
+    const scene_view *vw = &s->vw;
+    for (int i = 0; i < 3; i++) {
+        const double *V = vtx(sc, fi, i);
+        double d[3] = {V[0] - sc->eye[0], V[1] - sc->eye[1], V[2] - sc->eye[2]};
+        double ze = dot3(d, vw->w);
+        if (!(ze < -1e-9)) return;           /* behind the eye: keep flat */
+        xs[i] = vw->W / 2 + vw->f * dot3(d, vw->u) / -ze;
+        ys[i] = vw->H / 2 - vw->f * dot3(d, vw->v) / -ze;
+        const double *N = m->flat ? &s->fn[3 * fi] : &s->vn[3 * sc->fv[sc->f[fi].first + i]];
+        phong(s, m, V, N, I[i], NULL, 0);
+    }
+    double det = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (xs[2] - xs[0]) * (ys[1] - ys[0]);
+    if (!(fabs(det) > 1e-9)) return;
+    for (int c = 0; c < 3; c++) {
+        double d1 = I[1][c] - I[0][c], d2 = I[2][c] - I[0][c];
+        double ga = (d1 * (ys[2] - ys[0]) - d2 * (ys[1] - ys[0])) / det;
+        double gb = (d2 * (xs[1] - xs[0]) - d1 * (xs[2] - xs[0])) / det;
+        g[3 * c] = ga; g[3 * c + 1] = gb; g[3 * c + 2] = I[0][c] - ga * xs[0] - gb * ys[0];
+        g[9 + 2 * c] = fmin(I[0][c], fmin(I[1][c], I[2][c]));
+        g[10 + 2 * c] = fmax(I[0][c], fmax(I[1][c], I[2][c]));
+    }
+}
+
+hsr_status yp_shader_update(yp_shader *s, const hsr_scene *sc)
+{
+    s->sc = sc;
+    if (!scene_view_make(sc, &s->vw)) return HSR_EINVAL;
+    s->nl = sc->nlights;
+    for (int l = 0; l < s->nl; l++) {
+        memcpy(s->L[l], sc->lights[l].dir, sizeof s->L[l]);
+        if (!unit3(s->L[l])) return HSR_EINVAL;
+        memcpy(s->Lrgb[l], sc->lights[l].rgb, sizeof s->Lrgb[l]);
+    }
+    for (int c = 0; c < 3; c++) s->bg[c] = sc->bg[c] * YP_PIX;
+    memset(s->vn, 0, sizeof(double) * 3 * (size_t)(sc->nv + 1));
+    for (int fi = 0; fi < sc->nf; fi++) {
+        double n[3];
+        newell(sc, fi, n);
+        for (int i = 0; i < sc->f[fi].count; i++)
+            for (int k = 0; k < 3; k++) s->vn[3 * sc->fv[sc->f[fi].first + i] + k] += n[k];
+        if (!unit3(n)) n[0] = n[1] = n[2] = 0;
+        memcpy(&s->fn[3 * fi], n, sizeof n);
+    }
+    for (int v = 0; v < sc->nv; v++) unit3(&s->vn[3 * v]);
+    for (int fi = 0; fi < sc->nf; fi++) face_functions(s, fi);
+    return HSR_OK;
+}
+
+hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out, char *err, size_t errlen)
+{
+    if (!sc || !out) return HSR_EINVAL;
+    *out = NULL;
+    if (err && errlen) err[0] = 0;
+    /* no-wrap rule: A + sum_l I_l,c (kd_c + KS) <= 1 for every used material */
+    char *used = calloc((size_t)sc->nmat + 1, 1);
+    if (!used) return HSR_ENOMEM;
+    for (int fi = 0; fi < sc->nf; fi++) used[sc->f[fi].material] = 1;
+    for (int mi = 0; mi < sc->nmat; mi++) {
+        if (!used[mi]) continue;
+        const hsr_material *m = &sc->mat[mi];
+        for (int c = 0; c < 3; c++) {
+            double t = sc->ambient;
+            for (int l = 0; l < sc->nlights; l++) t += sc->lights[l].rgb[c] * (m->rgb[c] + m->ks);
+            if (t > 1 + 1e-9 || sc->ambient < 0 || m->rgb[c] < 0) {
+                if (err) snprintf(err, errlen, "%s:%d: material '%s' can exceed intensity 1 in %c "
+                                  "(A + sum I(kd+KS) = %.4g with %d light(s), first light on line %d); "
+                                  "lower kd, KS or the lights", sc->name[0] ? sc->name : "<scene>",
+                                  m->line, m->name, "RGB"[c], t, sc->nlights, sc->lights[0].line);
+                free(used);
+                return HSR_EPARSE;
+            }
+        }
+    }
+    free(used);
+    for (int c = 0; c < 3; c++)
+        if (!(sc->bg[c] >= 0 && sc->bg[c] <= 1)) {
+            if (err) snprintf(err, errlen, "%s: background colour outside [0,1]", sc->name[0] ? sc->name : "<scene>");
+            return HSR_EPARSE;
+        }
+    yp_shader *s = calloc(1, sizeof *s);
+    if (!s) return HSR_ENOMEM;
+    s->mode = mode;
+    s->vn = malloc(sizeof(double) * 3 * (size_t)(sc->nv + 1));
+    s->fn = malloc(sizeof(double) * 3 * (size_t)(sc->nf + 1));
+    s->flat = malloc(sizeof(double) * 3 * (size_t)(sc->nf + 1));
+    s->gour = malloc(sizeof(double) * 15 * (size_t)(sc->nf + 1));
+    if (!s->vn || !s->fn || !s->flat || !s->gour) { yp_shader_free(s); return HSR_ENOMEM; }
+    hsr_status st = yp_shader_update(s, sc);
+    if (st != HSR_OK) { yp_shader_free(s); return st; }
+    *out = s;
+    return HSR_OK;
+}
+
+void yp_shader_free(yp_shader *s)
+{
+    if (!s) return;
+    free(s->vn); free(s->fn); free(s->flat); free(s->gour); free(s);
+}

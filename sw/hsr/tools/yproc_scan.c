@@ -1,0 +1,227 @@
+/* yproc_scan.c - `yproc scan` and `yproc anim` (docs/yproc.md): scene ->
+ * HSR -> y-processor -> r/g/b command streams, stats.json, summary line. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include "hsr.h"
+
+int yproc_scan_main(int argc, char **argv);
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
+
+typedef struct opts {
+    const char *in, *out, *mode;
+    yp_options yo;
+    int frames, cmd, expect, full, width, height, mode_given;
+} opts;
+
+static int parse(int argc, char **argv, opts *o)
+{
+    memset(o, 0, sizeof *o);
+    yp_options_default(&o->yo);
+    o->in = argv[2]; o->mode = "640x480"; o->frames = 1;
+    int cap = 0;
+    for (int i = 3; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-o") && i + 1 < argc) o->out = argv[++i];
+        else if (!strcmp(a, "--mode") && i + 1 < argc) { o->mode = argv[++i]; o->mode_given = 1; }
+        else if (!strcmp(a, "--no-aa")) o->yo.aa = 0;
+        else if (!strcmp(a, "--cmd")) o->cmd = 1;
+        else if (!strcmp(a, "--expect")) o->expect = 1;
+        else if (!strcmp(a, "--full")) o->full = 1;
+        else if (!strcmp(a, "--shading") && i + 1 < argc) {
+            const char *v = argv[++i];
+            if (!strcmp(v, "flat")) o->yo.shading = YP_FLAT;
+            else if (!strcmp(v, "gouraud")) o->yo.shading = YP_GOURAUD;
+            else if (!strcmp(v, "phong")) o->yo.shading = YP_PHONG;
+            else return 2;
+        } else if (!strcmp(a, "--frames") && i + 1 < argc) { o->frames = atoi(argv[++i]); if (o->frames < 1) return 2; }
+        else if (!strcmp(a, "--tol") && i + 1 < argc) { o->yo.tol = atof(argv[++i]); if (!(o->yo.tol >= 0.01)) return 2; }
+        else if (!strcmp(a, "--capacity") && i + 1 < argc) { cap = atoi(argv[++i]); if (cap < 4) return 2; }
+        else return 2;
+    }
+    if (!o->out) return 2;
+    o->yo.capacity = yp_mode_capacity(o->mode, &o->width, &o->height);
+    if (!o->yo.capacity) { fprintf(stderr, "yproc: unknown mode '%s' (640x480, 640x485, 1280x1024)\n", o->mode); return 1; }
+    if (cap) o->yo.capacity = cap;
+    return 0;
+}
+
+static int mkdir_p(const char *d)
+{
+    if (mkdir(d, 0777) == 0 || errno == EEXIST) return 0;
+    fprintf(stderr, "%s: cannot create directory\n", d);
+    return 1;
+}
+
+static const char *shading_name(yp_shading s) { return s == YP_FLAT ? "flat" : s == YP_GOURAUD ? "gouraud" : "phong"; }
+
+typedef struct totals { long slots[3]; int maxslots[3], lines_degraded, lines_overflow, patterns_degraded; } totals;
+
+static void frame_totals(const yp_frame *fr, totals *t)
+{
+    memset(t, 0, sizeof *t);
+    for (int y = 0; y < fr->height; y++) {
+        const yp_line_stats *s = &fr->st[y];
+        int deg = 0, ov = 0;
+        for (int c = 0; c < 3; c++) {
+            t->slots[c] += s->slots[c];
+            if (s->slots[c] > t->maxslots[c]) t->maxslots[c] = s->slots[c];
+            deg |= s->degraded[c] > 0; ov |= s->overflow[c];
+            t->patterns_degraded += s->degraded[c];
+        }
+        t->lines_degraded += deg; t->lines_overflow += ov;
+    }
+}
+
+static int write_streams(const yp_frame *fr, const char *dir, int cmd)
+{
+    static const char *nm = "rgb";
+    char p[4096];
+    for (int c = 0; c < 3; c++) {
+        snprintf(p, sizeof p, "%s/%c.de48", dir, nm[c]);
+        if (yp_write_de48(fr, c, p) != HSR_OK) { fprintf(stderr, "%s: cannot write\n", p); return 1; }
+        if (cmd) {
+            snprintf(p, sizeof p, "%s/%c.cmd", dir, nm[c]);
+            if (yp_write_cmd(fr, c, p) != HSR_OK) { fprintf(stderr, "%s: cannot write\n", p); return 1; }
+        }
+    }
+    return 0;
+}
+
+/* expect.ppm: the frame these commands give (16-bit binary PPM, maxval
+ * 4095), ideal.f64: the exact target per pixel, float64 [3][H][W], LE */
+static int write_expect(const yp_frame *fr, const char *dir)
+{
+    char p[4096];
+    int W = fr->width, H = fr->height;
+    uint16_t *pix = malloc(sizeof(uint16_t) * 3 * (size_t)W * (size_t)H);
+    if (!pix) return 1;
+    for (int c = 0; c < 3; c++)
+        for (int y = 0; y < H; y++) yp_simulate_line(&fr->line[c * H + y], W, &pix[((size_t)c * H + y) * W]);
+    snprintf(p, sizeof p, "%s/expect.ppm", dir);
+    FILE *f = fopen(p, "wb");
+    if (!f) { free(pix); return 1; }
+    fprintf(f, "P6\n%d %d\n4095\n", W, H);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < 3; c++) {
+                uint16_t v = pix[((size_t)c * H + y) * W + x];
+                fputc(v >> 8, f); fputc(v & 255, f);
+            }
+    fclose(f);
+    free(pix);
+    snprintf(p, sizeof p, "%s/ideal.f64", dir);
+    f = fopen(p, "wb");
+    if (!f) return 1;
+    fwrite(fr->ideal, sizeof(double), 3 * (size_t)W * (size_t)H, f);   /* host order (x86: LE) */
+    fclose(f);
+    return 0;
+}
+
+static void stats_frame_json(FILE *f, const yp_frame *fr, const opts *o, const char *indent)
+{
+    totals t;
+    frame_totals(fr, &t);
+    fprintf(f, "%s\"totals\": {\"slots\": [%ld, %ld, %ld], \"max_slots\": [%d, %d, %d], "
+               "\"mean_slots\": [%.2f, %.2f, %.2f], \"lines_degraded\": %d, \"lines_overflow\": %d, "
+               "\"patterns_degraded\": %d, \"evals\": {\"eval0\": %d, \"eval1\": %d, \"eval2\": %d, \"eval3\": %d}, "
+               "\"knots\": %d, \"dis\": %d, \"partial_pixels\": %d, \"specular_evals\": %d}",
+            indent, t.slots[0], t.slots[1], t.slots[2], t.maxslots[0], t.maxslots[1], t.maxslots[2],
+            (double)t.slots[0] / fr->height, (double)t.slots[1] / fr->height, (double)t.slots[2] / fr->height,
+            t.lines_degraded, t.lines_overflow, t.patterns_degraded, fr->n_eval[0], fr->n_eval[1], fr->n_eval[2],
+            fr->n_eval[3], fr->n_knots, fr->n_dis, fr->n_partial, fr->n_spec);
+    (void)o;
+}
+
+static int write_stats(const char *dir, const yp_frame *fr, const opts *o, const hsr_scene *sc,
+                       double t_load, double t_hsr, double t_scan, double t_write, int nvis)
+{
+    char p[4096];
+    snprintf(p, sizeof p, "%s/stats.json", dir);
+    FILE *f = fopen(p, "w");
+    if (!f) { fprintf(stderr, "%s: cannot write\n", p); return 1; }
+    fprintf(f, "{\"format\": \"yproc-stats-1\", \"scene\": \"%s\", \"mode\": \"%s\", \"width\": %d, \"height\": %d,\n"
+               " \"capacity\": %d, \"aa\": %s, \"shading\": \"%s\", \"tol\": %g, \"faces\": %d, \"llr_domains\": %d,\n"
+               " \"times_ms\": {\"load\": %.3f, \"hsr\": %.3f, \"scan\": %.3f, \"write\": %.3f, \"frames_timed\": %d},\n ",
+            sc->name, o->mode, fr->width, fr->height, o->yo.capacity, o->yo.aa ? "true" : "false",
+            shading_name(o->yo.shading), o->yo.tol, sc->nf, nvis, t_load, t_hsr, t_scan, t_write, o->frames);
+    stats_frame_json(f, fr, o, "");
+    fprintf(f, ",\n \"lines\": [");
+    for (int y = 0; y < fr->height; y++) {
+        const yp_line_stats *s = &fr->st[y];
+        fprintf(f, "%s\n  {\"y\": %d, \"cmds\": [%d, %d, %d], \"slots\": [%d, %d, %d], \"patterns\": %d, "
+                   "\"partial\": %d, \"degraded\": [%d, %d, %d], \"overflow\": [%d, %d, %d]}",
+                y ? "," : "", y, s->cmds[0], s->cmds[1], s->cmds[2], s->slots[0], s->slots[1], s->slots[2],
+                s->patterns, s->partial, s->degraded[0], s->degraded[1], s->degraded[2],
+                s->overflow[0], s->overflow[1], s->overflow[2]);
+    }
+    fprintf(f, "\n]}\n");
+    return fclose(f) == 0 ? 0 : 1;
+}
+
+static int scan_main(opts *o)
+{
+    char err[1024] = "";
+    double t0 = now_ms();
+    hsr_scene *sc;
+    hsr_status st = hsr_scene_load(o->in, &sc, err, sizeof err);
+    if (st != HSR_OK) { fprintf(stderr, "%s\n", err[0] ? err : hsr_status_str(st)); return 1; }
+    /* --mode sets the raster (overriding the scene's `screen`); without it
+     * the scene's screen is kept with the 640x480 line capacity */
+    if (o->mode_given) { sc->width = o->width; sc->height = o->height; }
+    yp_shader *sh;
+    if ((st = yp_shader_new(sc, o->yo.shading, &sh, err, sizeof err)) != HSR_OK) {
+        fprintf(stderr, "%s\n", err[0] ? err : hsr_status_str(st)); hsr_scene_free(sc); return 1;
+    }
+    double t1 = now_ms();
+    hsr_ctx *h; double *shade;
+    if ((st = hsr_scene_build(sc, &h, &shade)) != HSR_OK) {
+        fprintf(stderr, "%s: %s\n", o->in, hsr_status_str(st)); yp_shader_free(sh); hsr_scene_free(sc); return 1;
+    }
+    free(shade);
+    double t2 = now_ms();
+    yp_frame *fr = NULL;
+    st = yp_frame_new(sc->width, sc->height, &fr);
+    for (int k = 0; k < o->frames && st == HSR_OK; k++) st = yp_scan(sh, h, &o->yo, 0, sc->height, fr);
+    double t3 = now_ms();
+    int rc = 0;
+    if (st != HSR_OK) { fprintf(stderr, "%s: scan conversion failed (%s)\n", o->in, hsr_status_str(st)); rc = 1; }
+    int nvis = 0;
+    for (int s = 0; s < hsr_llr_slots(h); s++) nvis += hsr_llr_get(h, s, NULL, NULL, NULL, NULL);
+    if (!rc) rc = mkdir_p(o->out) || write_streams(fr, o->out, o->cmd) || (o->expect && write_expect(fr, o->out));
+    double t4 = now_ms();
+    if (!rc) rc = write_stats(o->out, fr, o, sc, t1 - t0, t2 - t1, (t3 - t2) / o->frames, t4 - t3, nvis);
+    if (!rc) {
+        totals t;
+        frame_totals(fr, &t);
+        printf("yproc scan %s: %dx%d %s %s, %d faces, %d LLR domains; slots/line r/g/b mean %.0f/%.0f/%.0f max %d/%d/%d "
+               "of %d; lines degraded %d, overflow %d; hsr %.1f ms, scan %.1f ms/frame, write %.1f ms\n",
+               o->in, fr->width, fr->height, shading_name(o->yo.shading), o->yo.aa ? "aa" : "no-aa", sc->nf, nvis,
+               (double)t.slots[0] / fr->height, (double)t.slots[1] / fr->height, (double)t.slots[2] / fr->height,
+               t.maxslots[0], t.maxslots[1], t.maxslots[2], o->yo.capacity, t.lines_degraded, t.lines_overflow,
+               t2 - t1, (t3 - t2) / o->frames, t4 - t3);
+        if (t.lines_overflow)
+            fprintf(stderr, "yproc: warning: %d line(s) exceed %d slots even with flat shading (see stats.json)\n",
+                    t.lines_overflow, o->yo.capacity);
+    }
+    yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); hsr_scene_free(sc);
+    return rc;
+}
+
+int yproc_scan_main(int argc, char **argv)
+{
+    opts o;
+    int r = parse(argc, argv, &o);
+    if (r) return r;
+    if (!strcmp(argv[1], "scan")) return scan_main(&o);
+    return 2;
+}
