@@ -173,6 +173,22 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         if (!c.saw_both) { for (int i = 0; i < nlab; i++) hsr_domain_free(res[i]); continue; }
         hsr_domain_free(rem);
         rem = res[0];
+        int split = c.covered;
+        for (int pos = 0; pos <= c.k; pos++) split |= !hsr_domain_is_empty(res[2 + pos]);
+        if (!split) {
+            /* The new domain is hidden wherever it meets N (no covered part, no new
+             * front piece), so N keeps its shape: append id to N's hidden parents in
+             * place.  Destroying and recreating N would copy its whole parent list on
+             * every add, making n domains hidden behind one front domain cost O(n^2)
+             * each (Fig. 5.30 tri-spets must be linear). */
+            for (int i = 1; i < nlab; i++) hsr_domain_free(res[i]);
+            /* A re-add during damage repair may meet an N that already lists id; look
+             * in id's own lists (short), not in N's (long). */
+            int listed = iv_find(&h->m[id].invis, s) >= 0;
+            for (int j = 0; j < N->nvis && !listed; j++) listed = N->par.v[j] == id;
+            if (!listed && (!iv_push(&N->par, id) || !iv_push(&h->m[id].invis, s))) { st = HSR_ENOMEM; goto done; }
+            continue;
+        }
         /* N is replaced by its pieces; copy its parents first */
         int pre[HSR_MAX_PREFIX + 1], k = c.k;
         memcpy(pre, N->par.v, sizeof(int) * (size_t)k);
