@@ -134,13 +134,14 @@ def load_manifest(path: Path = MANIFEST, tier: str = "full") -> list[Case]:
     for e in doc.get("scene", []):
         if not wanted(e):
             continue
+        scene = REPO / e["scene"]
         for chips in e["chips"]:
-            scene = REPO / e["scene"]
-            add(Case(_safe(f"scene_{scene.stem}_c{chips}"), "scene", chips,
-                     e["scene"], params={"scene": str(scene),
-                                         "yproc_args": e.get("yproc_args",
-                                                             ["scan", "{scene}", "-o", "{out}",
-                                                              "--width", "{width}"])}), e)
+            for ch in e.get("channels", ["r", "g", "b"]):
+                add(Case(_safe(f"scene_{scene.stem}_{ch}_c{chips}"), "scene", chips,
+                         f"yproc scan {e['scene']} ({ch})",
+                         params={"scene": str(scene), "channel": ch,
+                                 "yproc_args": e.get("yproc_args",
+                                                     ["scan", "{scene}", "-o", "{outdir}"])}), e)
     names = [c.name for c in cases]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
@@ -232,17 +233,20 @@ class Unavailable(Exception):
 
 
 def scene_stream(case: Case, workdir: Path) -> list[isa.Command]:
-    """Run `yproc` on a scene; it writes a command file for a width of 9 x chips."""
+    """Run the y-processor (`yproc scan SCENE -o DIR`, sw/hsr) and take one colour's
+    instruction stream, DIR/<channel>.de48."""
     if not YPROC.exists():
         raise Unavailable(f"{YPROC.relative_to(REPO)} not built (make -C sw/hsr)")
-    out = workdir / "scene.cmd"
-    args = [a.format(scene=case.params["scene"], out=out, width=case.width)
+    outdir = workdir / "yproc"
+    outdir.mkdir(exist_ok=True)
+    args = [a.format(scene=case.params["scene"], outdir=outdir, width=case.width)
             for a in case.params["yproc_args"]]
     res = subprocess.run([str(YPROC), *args], capture_output=True, text=True, timeout=600)
+    out = outdir / f"{case.params['channel']}.de48"
     if res.returncode or not out.exists():
         msg = (res.stderr.strip().splitlines() or ["no output"])[0]
-        raise Unavailable(f"yproc {' '.join(args[:1])} failed ({res.returncode}): {msg}")
-    return asm.parse_file(out)
+        raise Unavailable(f"yproc {args[0]} failed ({res.returncode}): {msg}")
+    return binfmt.load_commands(out.read_bytes(), str(out))[0]
 
 
 def commands_for(case: Case, workdir: Path) -> list[isa.Command]:
@@ -346,13 +350,7 @@ def heatmap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _exe(chips: int, bug: bool) -> Path:
-    exe = harness.build(chips, bug)
-    if not exe.exists():  # build folder naming in transition (TRACE flag in the tag)
-        alt = sorted(exe.parent.parent.glob(f"array_c{chips}_b{int(bug)}_t1_tr0/Vde_array"))
-        if alt:
-            return alt[0]
-        raise FileNotFoundError(f"harness build for {chips} chips, bug={bug} not found ({exe})")
-    return exe
+    return harness.build(chips, bug)
 
 
 def _bug_model_cost(commands) -> int:
@@ -448,42 +446,51 @@ def _run_case(case: Case, exe: str, workdir: str) -> dict:
 # ---- failure analysis: trace compare and a windowed FST (the trace build) ----------------
 
 
-def _trace_available() -> bool:
-    return (REPO / "sw" / "diffengine" / "trace.py").exists()
+def _prefix(commands, line: int) -> list[isa.Command]:
+    """The stream up to and including the Refresh of `line` (cycle numbers unchanged)."""
+    return [c for ln in isa.split_lines(commands)[:line + 1] for c in ln]
 
 
-def trace_compare(case: Case, workdir: Path, line: int, col: int) -> str:
-    """Where the RTL and the structural model part (H3's `diffengine trace --compare`)."""
-    if not _trace_available():
-        return "trace: `diffengine trace` is not available in this tree"
-    lo = max(0, col - 1)
-    pes = ",".join(str(p) for p in range(lo, min(case.width, col + 2)))
-    args = [sys.executable, "-m", "diffengine.cli", "trace", str(workdir / "stream.de48"),
-            "--chips", str(case.chips), "--pes", pes, "--line", str(line), "--compare"]
-    if case.bug:
-        args.append("--bug")
-    try:
-        res = subprocess.run(args, capture_output=True, text=True, timeout=900, cwd=REPO)
-    except subprocess.TimeoutExpired:
-        return "trace --compare: timed out"
-    text = (res.stdout + res.stderr).strip()
-    return text or f"trace --compare exited {res.returncode} without output"
+def trace_compare(case: Case, commands, line: int, col: int) -> str:
+    """Where the RTL and the structural model part on `line`, PEs col-1..col+1
+    (`diffengine trace --compare --model-bug 0`: the model is always the correct one)."""
+    from . import trace
+
+    slots = isa.serialise(_prefix(commands, line))
+    t = trace.Timing.of(slots, case.chips)
+    lo, hi = t.line_window(line)
+    pes = list(range(max(0, col - 1), min(case.width, col + 2)))
+    r = trace.rtl_trace(slots, case.chips, case.bug, pes, lo, hi)
+    m = trace.model_trace(slots, case.chips, False, pes, lo, hi)
+    d = trace.first_difference(r.rows, m.rows)
+    head = (f"diffengine trace stream.cmd --chips {case.chips} --bug {int(case.bug)} "
+            f"--model-bug 0 --compare --line {line} --pes {pes[0]}-{pes[-1]}\n"
+            f"RTL (bug {int(case.bug)}) vs structural model (bug 0), cycles {lo}..{hi}: ")
+    if d is None:
+        return head + ("identical: the RTL does what the structural model does on this "
+                       "line, so the difference lies in the reference")
+    text = head + trace.describe(d)
+    at = [row for row in r.rows if row.split(",")[:2] == [str(d["cycle"]), str(d["pe"])]]
+    mt = [row for row in m.rows if row.split(",")[:2] == [str(d["cycle"]), str(d["pe"])]]
+    if at and mt:
+        text += "\n  RTL:   " + trace.text_row(at[0]) + "\n  model: " + trace.text_row(mt[0])
+    return text
 
 
-def write_waves(case: Case, workdir: Path, line: int, col: int) -> list[str]:
-    """A windowed FST of the bad line (and its GTKWave save file) from the trace build."""
-    try:
-        exe = harness.build(case.chips, case.bug, trace=True)  # type: ignore[call-arg]
-    except TypeError:
-        return []
-    fst = workdir / f"line{line}_col{col}.fst"
-    res = subprocess.run([str(exe), str(workdir / "stream.de48"), str(workdir / "w.depx"),
-                          "--quiet", "--fst", str(fst), "--line", str(line), "--col", str(col)],
-                         capture_output=True, text=True, timeout=900)
-    if res.returncode not in (0,):
-        (workdir / "waves.log").write_text(res.stdout + res.stderr)
-    return [p.name for p in sorted(workdir.glob(f"line{line}_col{col}.*"))
-            if p.suffix in (".fst", ".gtkw")]
+def write_waves(case: Case, commands, workdir: Path, line: int, col: int) -> list[str]:
+    """A windowed FST of the bad line and its GTKWave save file (the trace build's
+    `--fst FILE --line L --col Q`), next to the report."""
+    exe = harness.build(case.chips, case.bug, trace=True)
+    stem = f"line{line}_col{col}"
+    src = workdir / "prefix.de48"
+    src.write_bytes(binfmt.encode_de48(isa.serialise(_prefix(commands, line))))
+    res = subprocess.run([str(exe), str(src), str(workdir / "waves.depx"), "--quiet",
+                          "--fst", str(workdir / f"{stem}.fst"), "--line", str(line),
+                          "--col", str(col)], capture_output=True, text=True, timeout=900)
+    (workdir / "waves.log").write_text(res.stdout + res.stderr)
+    src.unlink()
+    (workdir / "waves.depx").unlink(missing_ok=True)
+    return [p.name for p in sorted(workdir.glob(f"{stem}.*")) if p.suffix in (".fst", ".gtkw")]
 
 
 # ---- reports ---------------------------------------------------------------------------
@@ -659,18 +666,23 @@ def run(cases: list[Case], out: Path, jobs: int = 2, waves: bool = True, tier: s
         for c in cases:
             results[c.name] = r = futs[c.name].result()
             log(f"  {verdict(c, r):5s} {c.name}  {r['message'][:90]}")
+    example = next((c.name for c in cases if verdict(c, results[c.name]) == "XFAIL"), None)
     for c in cases:
         r = results[c.name]
-        if r.get("first") is None:
-            continue
+        if r.get("first") is None or not (verdict(c, r) != "XFAIL" or c.name == example):
+            continue  # analysed: every unexpected failure, and one expected one as an example
         y, x = r["first"]
         wd = cases_dir / c.name
-        if verdict(c, r) != "XFAIL" or c.name == next(
-                (k.name for k in cases if k.bug and results[k.name].get("first")), None):
-            # every unexpected failure, and the first expected one (as an example)
-            r["trace"] = trace_compare(c, wd, y, x)
+        cmds = asm.parse_file(wd / "stream.cmd")
+        tb = time.monotonic()
+        try:
+            r["trace"] = trace_compare(c, cmds, y, x)
             if waves:
-                r["waves"] = write_waves(c, wd, y, x)
+                r["waves"] = write_waves(c, cmds, wd, y, x)
+        except Exception as e:  # noqa: BLE001 - the analysis must not hide the verdict
+            r["trace"] = (r.get("trace") or "") + f"\nanalysis failed: {type(e).__name__}: {e}"
+        log(f"sim: analysed {c.name} (trace compare{', FST' if waves else ''}) in "
+            f"{time.monotonic() - tb:.1f} s")
     return results, time.monotonic() - t0
 
 
