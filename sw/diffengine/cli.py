@@ -332,6 +332,9 @@ def build_parser() -> argparse.ArgumentParser:
     # Listed for --help only; main() hands `trace` to diffengine.trace.trace_main.
     sub.add_parser("trace", help="per-PE state per cycle from the RTL harness or the "
                    "structural model, breakpoints, RTL-vs-model compare (diffengine trace -h)")
+    # Listed for --help only; main() hands `inspect` to diffengine.inspect_page.inspect_main.
+    sub.add_parser("inspect", help="one frame as a self-contained HTML page: image, scanline "
+                   "graph, per-pixel commands and register history (diffengine inspect -h)")
     return p
 
 
@@ -343,6 +346,9 @@ def main(argv=None) -> int:
     if argv[:1] == ["trace"]:  # its own argument parser (diffengine.trace)
         from .trace import trace_main
         return trace_main(argv[1:])
+    if argv[:1] == ["inspect"]:  # its own argument parser (diffengine.inspect_page)
+        from .inspect_page import inspect_main
+        return inspect_main(argv[1:])
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
