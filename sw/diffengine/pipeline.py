@@ -1,0 +1,265 @@
+"""The full pipeline behind `make demo` (docs/pipeline.md, "Demo pipeline"):
+
+  scene + OBJ --yproc scan (HSR + scan conversion + shading, C)--> r/g/b.de48
+     --> Verilated display_controller (sim/dc, 3 x NumChips chips)  --> RTL frame (PNG)
+     --> golden model (diffengine.functional, per colour)           --> must equal the RTL
+     --> numpy reference renderer (16x16 Phong, diffengine.reference) --> PSNR
+
+`run()` does all of it and returns a report dict; scripts/demo.py is its command line.
+Screens other than 640x480 run the controller's test mode (mode 3) with a line of the
+640x480 mode's length (HTotal = 800, so the same 799 slots per line) and a short
+vertical blank; the array needs at least as many PEs (9 per chip) as the screen has
+columns.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import binfmt, dc_harness, frame, functional, reference
+
+REPO = Path(__file__).resolve().parents[2]
+YPROC = REPO / "sw" / "hsr" / "build" / "yproc"
+MIN_PSNR = 38.0
+H_TOTAL = 800          # 640x480's line: 799 command slots per line in every mode we run
+
+
+class PipelineError(RuntimeError):
+    pass
+
+
+class Progress:
+    """A one-line text progress bar on stderr (only when stderr is a terminal, or
+    always with force=True); `None`-safe to call from callbacks."""
+
+    def __init__(self, label: str, enabled: bool = True, force: bool = False):
+        self.label = label
+        self.on = enabled and (force or sys.stderr.isatty())
+        self.t0 = time.monotonic()
+        self.last = 0.0
+
+    def __call__(self, done: float, total: float) -> None:
+        if not self.on or total <= 0:
+            return
+        now = time.monotonic()
+        if now - self.last < 0.2 and done < total:
+            return
+        self.last = now
+        frac = min(1.0, done / total)
+        bar = "#" * int(30 * frac) + "." * (30 - int(30 * frac))
+        el = now - self.t0
+        eta = el / frac - el if frac > 0 else 0
+        print(f"\r  {self.label:<10} [{bar}] {100 * frac:5.1f} %  {el:6.1f} s"
+              f"  (eta {eta:5.1f} s) ", end="", file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.on:
+            print("\r" + " " * 79 + "\r", end="", file=sys.stderr, flush=True)
+
+
+def screen_of(scene: Path) -> tuple[int, int]:
+    sc = reference.Scene()
+    for line in Path(scene).read_text().splitlines():
+        tok = line.split("#", 1)[0].split()
+        if tok[:1] == ["screen"] and len(tok) == 3:
+            sc.width, sc.height = int(float(tok[1])), int(float(tok[2]))
+    return sc.width, sc.height
+
+
+def controller_setup(width: int, height: int, chips: int) -> tuple[int, tuple]:
+    """(mode, test geometry) for a screen: mode 0 for 640x480, else test mode 3 with
+    HTotal = 800 and VFp/VSync/VBp = 1/2/2."""
+    if chips * 9 < width:
+        raise PipelineError(f"{chips} chips = {chips * 9} PEs per colour cannot show "
+                            f"{width} columns (need at least {-(-width // 9)} chips)")
+    if (width, height) == (640, 480):
+        return 0, dc_harness.DEFAULT_TEST
+    if width + 16 + 96 + 1 > H_TOTAL:
+        raise PipelineError(f"screen width {width}: only 640x480 or widths up to "
+                            f"{H_TOTAL - 113} (test mode) are supported")
+    return 3, (width, 16, 96, H_TOTAL - width - 112, height, 1, 2, 2)
+
+
+def build_yproc() -> Path:
+    res = subprocess.run(["make", "-s", "-C", str(REPO / "sw" / "hsr"), "build/yproc"],
+                         capture_output=True, text=True)
+    if res.returncode or not YPROC.exists():
+        raise PipelineError("cannot build sw/hsr/build/yproc:\n" + res.stdout + res.stderr)
+    return YPROC
+
+
+def yproc_scan(scene: Path, outdir: Path, aa: bool = True, shading: str | None = None,
+               extra: tuple[str, ...] = ()) -> dict:
+    """Run `yproc scan`; returns its stats.json (plus 'seconds')."""
+    exe = build_yproc()
+    outdir.mkdir(parents=True, exist_ok=True)
+    cmd = [str(exe), "scan", str(scene), "-o", str(outdir)]
+    if not aa:
+        cmd.append("--no-aa")
+    if shading:
+        cmd += ["--shading", shading]
+    cmd += list(extra)
+    t0 = time.monotonic()
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    secs = time.monotonic() - t0
+    if res.returncode:
+        raise PipelineError(f"{' '.join(cmd)} failed ({res.returncode}):\n{res.stderr.strip()}")
+    for c in "rgb":
+        if not (outdir / f"{c}.de48").exists():
+            raise PipelineError(f"yproc scan wrote no {outdir / (c + '.de48')}")
+    st = {}
+    if (outdir / "stats.json").exists():
+        st = json.loads((outdir / "stats.json").read_text())
+    st["seconds"] = secs
+    return st
+
+
+def golden(paths, width: int, height: int, carry_bug: bool = False,
+           progress=None) -> np.ndarray:
+    """The golden model frame (H, W, 3) uint16 from three .de48 streams."""
+    out = np.zeros((height, width, 3), dtype=np.uint16)
+    streams = []
+    for p in paths:
+        cmds, _ = binfmt.load_commands(Path(p).read_bytes(), str(p))
+        streams.append(cmds)
+    total = sum(len(c) for c in streams)
+    done = 0
+    for ch, cmds in enumerate(streams):
+        lines = [[]]
+        for c in cmds:                      # split into lines (keep their Refresh)
+            lines[-1].append(c)
+            if c.op == "REFRESH":
+                lines.append([])
+        lines = [ln for ln in lines if ln and ln[-1].op == "REFRESH"]
+        if len(lines) > height:
+            raise PipelineError(f"{paths[ch]}: {len(lines)} lines, the screen has {height}")
+        for k in range(0, len(lines), 64):
+            chunk = [c for ln in lines[k:k + 64] for c in ln]
+            out[k:k + 64][:len(lines[k:k + 64]), :, ch] = functional.render(chunk, width,
+                                                                            carry_bug)
+            done += len(chunk)
+            if progress:
+                progress(done, total)
+    return out
+
+
+def _reference_cached(scene: Path, cache_dir: Path, samples: int = 16, progress=None):
+    """The reference frame, cached under cache_dir by the scene's (and its OBJs') text and
+    the renderer's source."""
+    h = hashlib.sha256()
+    h.update(Path(reference.__file__).read_bytes())
+    h.update(str(samples).encode())
+    text = scene.read_text()
+    h.update(text.encode())
+    for line in text.splitlines():
+        tok = line.split("#", 1)[0].split()
+        if tok[:1] == ["obj"] and len(tok) >= 2:
+            p = Path(tok[1])
+            p = p if p.is_absolute() else scene.parent / p
+            if p.exists():
+                h.update(p.read_bytes())
+    path = cache_dir / f".reference_{h.hexdigest()[:16]}.npy"
+    if path.exists():
+        return np.load(path), True
+    img = reference.render_file(scene, samples=samples, progress=progress)
+    cache_dir.mkdir(parents=True, exist_ok=True)
+    np.save(path, img)
+    return img, False
+
+
+def run(scene, outdir, chips: int = 72, threads: int = 1, rtl: bool = True,
+        aa: bool = True, shading: str | None = None, num_buf: int = 1,
+        show_progress: bool = True, log=print, ref_samples: int = 16,
+        png_name: str = "demo") -> dict:
+    """The whole pipeline; returns the report (also written to OUTDIR/<png_name>_report.json).
+
+    Raises PipelineError on a failed stage; the report's 'bit_identical' and 'psnr_db'
+    say whether the RTL frame equals the golden model and how close it is to the
+    reference (the caller decides what to do with PSNR < 38 dB)."""
+    scene, outdir = Path(scene).resolve(), Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    W, H = screen_of(scene)
+    mode, test = controller_setup(W, H, chips)
+    rep: dict = {"scene": str(scene.relative_to(REPO) if scene.is_relative_to(REPO) else scene),
+                 "screen": [W, H], "chips_per_colour": chips, "pes_per_colour": 9 * chips,
+                 "mode": mode, "test_geometry": list(test) if mode == 3 else None,
+                 "threads": threads, "anti_aliasing": aa, "shading": shading or "scene",
+                 "stages": {}}
+    stages = rep["stages"]
+
+    def stage(name, secs):
+        stages[name] = round(secs, 3)
+        log(f"  {name:<28} {secs:8.2f} s")
+
+    log(f"demo: {rep['scene']} at {W}x{H}, {chips} chips x 3 colours"
+        + ("" if rtl else " (model only, --no-rtl)"))
+    cmd_dir = outdir / f"{png_name}_cmd"
+    t0 = time.monotonic()
+    ys = yproc_scan(scene, cmd_dir, aa=aa, shading=shading)
+    stage("yproc scan (HSR+scan+shade)", ys["seconds"])
+    rep["yproc"] = ys
+    paths = [cmd_dir / f"{c}.de48" for c in "rgb"]
+    rep["instructions"] = {c: (p.stat().st_size - 8) // 6 for c, p in zip("RGB", paths)}
+
+    pb = Progress("golden", show_progress)
+    t = time.monotonic()
+    gold = golden(paths, W, H, progress=pb)
+    pb.close()
+    stage("golden model (functional)", time.monotonic() - t)
+
+    if rtl:
+        cfg = dc_harness.Config(chips=chips, num_buf=num_buf, threads=threads, test=test)
+        t = time.monotonic()
+        _, rebuilt, bsecs = dc_harness.build(cfg)
+        stage("RTL build" + (" (cold)" if rebuilt else " (cached)"), bsecs)
+        rep["rtl_build"] = {"seconds": round(bsecs, 3), "rebuilt": rebuilt, "config": cfg.tag}
+        pb = Progress("RTL", show_progress)
+        t = time.monotonic()
+        frames, st = dc_harness.run(paths, cfg, mode=mode, progress=pb)
+        pb.close()
+        stage("RTL display_controller", time.monotonic() - t)
+        rtl_frame = frames[-1]
+        rep["rtl"] = {k: st[k] for k in ("cycles", "seconds", "cycles_per_second", "frames",
+                                         "h_total", "v_total", "sync", "align_err",
+                                         "pix_collision", "threads")}
+        rep["load_monitor"] = {c: {k: v for k, v in m.items() if k != "line_issued"}
+                               for c, m in st["load_monitor"].items()}
+        rep["commands_per_line"] = {c: m["line_issued"] for c, m in st["load_monitor"].items()}
+        log(dc_harness.monitor_summary(st))
+        diff = rtl_frame != gold
+        rep["bit_identical"] = not diff.any()
+        if diff.any():
+            y, x, c = np.argwhere(diff)[0]
+            rep["first_difference"] = {"x": int(x), "y": int(y), "channel": "RGB"[c],
+                                       "rtl": int(rtl_frame[y, x, c]), "golden": int(gold[y, x, c]),
+                                       "pixels": int(diff.any(-1).sum())}
+        img = rtl_frame
+    else:
+        rep["bit_identical"] = None
+        img = gold
+    frame.write_png16(outdir / f"{png_name}.png", img, "diffengine demo")
+    frame.write_png8(outdir / f"{png_name}_8bit.png", img, "diffengine demo")
+    if rtl:
+        frame.write_png16(outdir / f"{png_name}_golden.png", gold, "diffengine golden model")
+
+    pb = Progress("reference", show_progress)
+    t = time.monotonic()
+    ref_img, cached = _reference_cached(scene, outdir, ref_samples, progress=pb)
+    pb.close()
+    stage("reference renderer" + (" (cached)" if cached else ""), time.monotonic() - t)
+    frame.write_png16(outdir / f"{png_name}_reference.png",
+                      np.clip(np.round(ref_img), 0, 4095).astype(np.uint16), "diffengine ref")
+    rep["psnr_db"] = round(reference.psnr(gold, ref_img), 3)
+    err = np.abs(gold.astype(np.float64) - ref_img)
+    rep["error"] = {"max": round(float(err.max()), 2), "mean": round(float(err.mean()), 4),
+                    "p99": round(float(np.percentile(err, 99)), 2)}
+    rep["total_seconds"] = round(time.monotonic() - t0, 3)
+    (outdir / f"{png_name}_report.json").write_text(json.dumps(rep, indent=1) + "\n")
+    return rep
