@@ -606,11 +606,12 @@ int main(int argc, char** argv) {
     for (long long p = std::max(0LL, q - 1); p <= std::min<long long>(n_pe - 1, q + 1); ++p)
       wave_pes.push_back(static_cast<int>(p));
     fst = std::make_unique<VerilatedFstC>();
-    // Only the top ports, the array level and the chips of the shown PEs are dumped.
+    // Only the top ports, the array level and the chips of the shown PEs are dumped
+    // (a level of 0 would mean everything).
     fst->dumpvars(1, "TOP");
     fst->dumpvars(1, "TOP.de_array");
     for (int p : wave_pes)
-      fst->dumpvars(0, "TOP.de_array.g_chip[" + std::to_string(p / kPePerChip) + "]");
+      fst->dumpvars(99, "TOP.de_array.g_chip[" + std::to_string(p / kPePerChip) + "]");
     top->trace(fst.get(), 99);
   }
   auto state_of = [&](uint64_t c, const PeProbe& pr) {
