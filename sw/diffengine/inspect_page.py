@@ -81,7 +81,7 @@ def register_history(line_cmds, width: int, carry_bug: bool = False, cycle0: int
         for i, (k, pe) in enumerate(zip(ks.tolist(), pes.tolist())):
             flags = "".join(ch if f[i] else "." for ch, f in zip(FLAG_LETTERS, fl))
             hist.setdefault(pe, []).append(
-                [cycle0 + step + pe // PE_PER_CHIP, k, int(A[i]), int(B[i]), int(C[i]),
+                [cycle0 + step + 1 + pe // PE_PER_CHIP, k, int(A[i]), int(B[i]), int(C[i]),
                  int(D[i]), flags])
     return hist
 
