@@ -1,0 +1,110 @@
+// UART receiver of the board top (8N1, LSB first), docs/board.md §3.
+//
+// The line is synchronised by two flip-flops, a start bit is confirmed at its middle and
+// every bit is sampled at its middle (ClkPerBit clocks apart). A stop bit that reads 0
+// is a framing error: the byte is not delivered, frame_err_o pulses for one clock, and
+// the receiver waits for the line to return to idle (1) before it looks for the next
+// start bit, so a break or a wrong baud rate yields errors, not garbage bytes.
+module de_uart_rx #(
+  parameter int unsigned ClkPerBit = 217   // 25 MHz / 115200 baud
+) (
+  input  logic       clk_i,
+  input  logic       rst_i,
+  input  logic       rx_i,
+  output logic       valid_o,      // one clock per received byte
+  output logic [7:0] data_o,
+  output logic       frame_err_o   // one clock per framing error
+);
+  if (ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
+    $error("de_uart_rx: ClkPerBit must be 4..65535");
+  end
+
+  typedef enum logic [2:0] {SIdle, SStart, SData, SStop, SBreak} state_e;
+
+  state_e      state_d, state_q;
+  logic [15:0] cnt_d, cnt_q;
+  logic [2:0]  bit_d, bit_q;
+  logic [7:0]  sh_d, sh_q;
+  logic        rx_q, rx_q2;
+  logic        valid_d, valid_q, ferr_d, ferr_q;
+
+  always_comb begin
+    state_d = state_q;
+    cnt_d   = cnt_q;
+    bit_d   = bit_q;
+    sh_d    = sh_q;
+    valid_d = 1'b0;
+    ferr_d  = 1'b0;
+    unique case (state_q)
+      SIdle: begin
+        if (!rx_q2) begin
+          state_d = SStart;
+          cnt_d   = 16'(ClkPerBit / 2 - 1);
+        end
+      end
+      SStart: begin
+        if (cnt_q != 16'd0) begin
+          cnt_d = cnt_q - 16'd1;
+        end else if (!rx_q2) begin
+          // Still low in the middle of the start bit: a real start bit.
+          state_d = SData;
+          cnt_d   = 16'(ClkPerBit - 1);
+          bit_d   = 3'd0;
+        end else begin
+          state_d = SIdle;   // a glitch
+        end
+      end
+      SData: begin
+        if (cnt_q != 16'd0) begin
+          cnt_d = cnt_q - 16'd1;
+        end else begin
+          sh_d  = {rx_q2, sh_q[7:1]};
+          cnt_d = 16'(ClkPerBit - 1);
+          bit_d = bit_q + 3'd1;
+          if (bit_q == 3'd7) state_d = SStop;
+        end
+      end
+      SStop: begin
+        if (cnt_q != 16'd0) begin
+          cnt_d = cnt_q - 16'd1;
+        end else if (rx_q2) begin
+          valid_d = 1'b1;
+          state_d = SIdle;
+        end else begin
+          ferr_d  = 1'b1;
+          state_d = SBreak;
+        end
+      end
+      SBreak: begin
+        if (rx_q2) state_d = SIdle;
+      end
+      default: state_d = SIdle;
+    endcase
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      rx_q    <= 1'b1;
+      rx_q2   <= 1'b1;
+      state_q <= SIdle;
+      cnt_q   <= 16'd0;
+      bit_q   <= 3'd0;
+      sh_q    <= 8'd0;
+      valid_q <= 1'b0;
+      ferr_q  <= 1'b0;
+    end else begin
+      rx_q    <= rx_i;
+      rx_q2   <= rx_q;
+      state_q <= state_d;
+      cnt_q   <= cnt_d;
+      bit_q   <= bit_d;
+      sh_q    <= sh_d;
+      valid_q <= valid_d;
+      ferr_q  <= ferr_d;
+    end
+  end
+
+  assign valid_o     = valid_q;
+  assign data_o      = sh_q;
+  assign frame_err_o = ferr_q;
+endmodule

@@ -1,0 +1,476 @@
+"""Board top (rtl/board/de_board_core.sv) and TMDS encoder tests, cocotb on Verilator.
+
+test_tmds_encoder (toplevel de_tmds_enc): every symbol equals the DVI 1.0 model of
+tmds.py (written from the specification's flow chart); every 8-bit value is encoded in
+every reachable running-disparity state and decodes back to itself; the running
+disparity of the symbols the RTL sends never leaves [-8, 8] (the model's reachable set);
+control tokens in blanking, cnt restarting at 0.
+
+test_load_and_play (toplevel de_board_core, 1-chip arrays, small test video mode):
+a host model builds a .de32 image per colour from a random command list (sw/diffengine:
+randgen -> frame-store grid -> binfmt.framestore_encode / encode_de32), sends it over the
+UART line at ClkPerBit = 8 clocks per bit (the board uses 217 = 115200 baud at 25 MHz;
+the sim divisor only shortens the run) with the loader protocol of docs/board.md §3,
+with one checksum error, one UART framing error and one garbage byte injected and retried;
+then the testbench decodes the three TMDS symbol streams back to pixels, hsync and vsync
+and checks, exactly:
+  * every displayed frame of every colour is either the previous image or the new one,
+    switching once, at a frame boundary, and ends on the new one; the new image equals
+    functional.render() of binfmt.map_word() of the frame-store words (window and
+    compensation flag of the .de32) with the carry bug on, through the 8-bit output
+    selection ('O' command);
+  * a second image loaded at another base and switched in (double buffering) the same;
+  * sync: DE runs of HActive, hsync HSync wide and HFp after DE, HTotal apart, frames of
+    VActive lines; control tokens only in blanking, data symbols only in DE;
+  * the loader's replies, the status counters (framing, checksum, command errors, all
+    exactly 1-2 as injected), the controller ID and the Load Monitors' late-line and
+    dropped-word totals (0) read over the UART.
+SEED=<n> replays.
+"""
+from __future__ import annotations
+
+import random
+import sys
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent))
+sys.path.insert(0, str(HERE.parent.parent / "sw"))
+
+import tmds  # noqa: E402
+from diffengine import binfmt, functional, isa, randgen  # noqa: E402
+
+NCH = 3
+
+
+# ====================================================================== TMDS encoder
+@cocotb.test()
+async def test_tmds_encoder(dut):
+    from common.run import seed_from_env
+    rng = random.Random(seed_from_env())
+    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
+    dut.rst_i.value = 1
+    dut.de_i.value = 0
+    dut.data_i.value = 0
+    dut.c_i.value = 0
+    await ClockCycles(dut.clk_i, 2)
+    await FallingEdge(dut.clk_i)
+    dut.rst_i.value = 0
+
+    model = tmds.Encoder()
+    reach = tmds.reachable_disparity()
+    assert reach == set(range(-8, 9, 2)), reach
+    stats = dict(symbols=0, max_abs=0)
+    running = [0]
+
+    async def drive(de: int, d: int, c: int) -> None:
+        want = model.step(bool(de), d, c)
+        dut.de_i.value = de
+        dut.data_i.value = d
+        dut.c_i.value = c
+        await RisingEdge(dut.clk_i)
+        await ReadOnly()
+        got = int(dut.sym_o.value)
+        assert got == want, f"de={de} d={d:#04x} c={c}: RTL {got:010b}, model {want:010b}"
+        kind, val = tmds.decode(got)
+        if de:
+            assert (kind, val) == ("data", d), f"{d:#04x} -> {got:010b} decodes to {kind} {val}"
+            running[0] += tmds.disparity(got)
+            assert running[0] == model.cnt, "model cnt is not the sent disparity"
+            assert abs(running[0]) <= 8 and running[0] in reach, running[0]
+            stats["max_abs"] = max(stats["max_abs"], abs(running[0]))
+        else:
+            assert (kind, val) == ("ctrl", c)
+            running[0] = 0
+        stats["symbols"] += 1
+        await FallingEdge(dut.clk_i)
+
+    # Random video: DE runs of random length, random pixels, random control in between.
+    for _ in range(300):
+        for _ in range(rng.randrange(1, 60)):
+            await drive(1, rng.randrange(256), 0)
+        for _ in range(rng.randrange(1, 4)):
+            await drive(0, 0, rng.randrange(4))
+
+    # Every value in every reachable disparity state: a shortest input path to the state
+    # (from blanking, cnt 0), then the value.
+    paths = {0: []}
+    frontier = [0]
+    while frontier:
+        nxt = []
+        for s in frontier:
+            for d in range(256):
+                e = tmds.Encoder()
+                e.cnt = s
+                e.step(True, d)
+                if e.cnt not in paths:
+                    paths[e.cnt] = paths[s] + [d]
+                    nxt.append(e.cnt)
+        frontier = nxt
+    covered = 0
+    for s, path in sorted(paths.items()):
+        for d in range(256):
+            await drive(0, 0, 0)
+            for p in path:
+                await drive(1, p, 0)
+            assert model.cnt == s
+            await drive(1, d, 0)
+            covered += 1
+    assert covered == len(reach) * 256
+    dut._log.info(f"TMDS: {stats['symbols']} symbols equal to the model; all 256 values x "
+                  f"{len(reach)} disparity states round-trip; max |running disparity| "
+                  f"{stats['max_abs']} (bound 8)")
+
+
+# ====================================================================== board top
+def geom(dut) -> dict:
+    g = {k: int(getattr(dut, k).value) for k in (
+        "TestHActive", "TestHFp", "TestHSync", "TestHBp", "TestVActive", "TestVFp",
+        "TestVSync", "TestVBp", "NumChips", "CarryBug", "FsDepth", "ClkPerBit",
+        "TimeoutBits")}
+    g["HTotal"] = g["TestHActive"] + g["TestHFp"] + g["TestHSync"] + g["TestHBp"]
+    g["VTotal"] = g["TestVActive"] + g["TestVFp"] + g["TestVSync"] + g["TestVBp"]
+    g["n_pe"] = 9 * g["NumChips"]
+    return g
+
+
+def fs_quantise(cmd: isa.Command, w: int, rng: random.Random) -> isa.Command:
+    """Move a random command onto the frame store's grid at window w (docs/formats.md §3)."""
+    lim = 1 << 26
+
+    def q(v: int) -> int:
+        return max(-lim, min(lim - 1, v >> (4 + w))) << (4 + w)
+
+    x, dx = min(cmd.x, 1023), min(cmd.dx, 1023)
+    if cmd.op == "EVAL0":
+        return isa.Command("EVAL0", x, dx, (rng.randrange(64) << w,))
+    if cmd.op in ("ACCMODE", "NOP", "REFRESH"):
+        return cmd
+    if cmd.op == "DIS":
+        return isa.Command("DIS", x, dx)
+    return isa.Command(cmd.op, x, dx, tuple(q(v) for v in cmd.values))
+
+
+def make_image(rng: random.Random, g: dict, w: int, max_words: int) -> list[isa.Command]:
+    """VActive lines of random commands, at most max_words frame-store words per line."""
+    cmds = []
+    for _ in range(g["TestVActive"]):
+        line, n = [], 0
+        for _ in range(rng.randrange(0, 6)):
+            c = fs_quantise(randgen.command(rng, g["n_pe"]), w, rng)
+            k = len(isa.slots(c))
+            if n + k > max_words:
+                break
+            line.append(c)
+            n += k
+        cmds += line + [isa.Command("REFRESH")]
+    return cmds
+
+
+def out8(p: int, w: int, sat: bool) -> int:
+    w = min(w, 4)
+    sh = p >> w
+    if not sat:
+        return sh & 0xFF
+    if p & 0x800:
+        return 0
+    return 0xFF if sh >> 8 else sh & 0xFF
+
+
+def golden(de32: bytes, g: dict, shift: int, sat: bool) -> np.ndarray:
+    """8-bit frame of one colour: functional model of the mapped frame-store words."""
+    words, window, comp = binfmt.decode_de32(de32)
+    cmds = binfmt.deserialise(binfmt.framestore_slots(words, window, comp))
+    pix = functional.render(cmds, width=g["n_pe"], carry_bug=bool(g["CarryBug"]))
+    assert pix.shape == (g["TestVActive"], g["n_pe"])
+    return np.vectorize(lambda p: out8(int(p), shift, sat))(pix).astype(np.uint8)
+
+
+def with_chk(body: bytes) -> bytes:
+    return body + bytes([(-sum(body)) & 0xFF])
+
+
+def cmd_w(ch: int, addr: int, words: list[int]) -> bytes:
+    return with_chk(b"W" + bytes([ch]) + addr.to_bytes(2, "big") + len(words).to_bytes(2, "big")
+                    + b"".join(x.to_bytes(4, "big") for x in words))
+
+
+def cmd_p(ch: int, base: int, n: int, window: int, comp: bool) -> bytes:
+    return with_chk(b"P" + bytes([ch]) + base.to_bytes(2, "big") + n.to_bytes(2, "big")
+                    + bytes([window, int(comp)]))
+
+
+class Host:
+    """UART host model: 8N1 at ClkPerBit clocks per bit, replies collected in order."""
+
+    def __init__(self, dut, g):
+        self.dut, self.g = dut, g
+        self.cpb = g["ClkPerBit"]
+        self.rx: list[int] = []
+        cocotb.start_soon(self._receive())
+
+    async def send(self, data: bytes, bad_stop_at: int | None = None) -> None:
+        dut = self.dut
+        for k, b in enumerate(data):
+            bits = [0] + [(b >> i) & 1 for i in range(8)] + [0 if k == bad_stop_at else 1]
+            for bit in bits:
+                dut.uart_rx_i.value = bit
+                await ClockCycles(dut.clk_i, self.cpb)
+            if k == bad_stop_at:   # a broken stop bit; the line idles one bit before the next
+                dut.uart_rx_i.value = 1
+                await ClockCycles(dut.clk_i, self.cpb)
+        dut.uart_rx_i.value = 1
+
+    async def _receive(self) -> None:
+        dut = self.dut
+        while True:
+            await FallingEdge(dut.uart_tx_o)
+            await ClockCycles(dut.clk_i, self.cpb // 2)
+            if int(dut.uart_tx_o.value):
+                continue
+            b = 0
+            for i in range(8):
+                await ClockCycles(dut.clk_i, self.cpb)
+                b |= int(dut.uart_tx_o.value) << i
+            await ClockCycles(dut.clk_i, self.cpb)
+            assert int(dut.uart_tx_o.value) == 1, "framing error on the board's TX line"
+            self.rx.append(b)
+
+    async def reply(self, n: int, timeout: int | None = None) -> bytes:
+        timeout = timeout or 40 * self.cpb * (n + 2)
+        for _ in range(timeout):
+            if len(self.rx) >= n:
+                out, self.rx = bytes(self.rx[:n]), self.rx[n:]
+                return out
+            await RisingEdge(self.dut.clk_i)
+        raise AssertionError(f"no {n}-byte reply within {timeout} clocks (got {self.rx})")
+
+    async def command(self, data: bytes, n_reply: int = 1, bad_stop_at: int | None = None,
+                      timeout: int | None = None) -> bytes:
+        assert not self.rx, f"unexpected bytes from the board: {self.rx}"
+        await self.send(data, bad_stop_at=bad_stop_at)
+        return await self.reply(n_reply, timeout=timeout)
+
+    async def load(self, ch: int, base: int, words: list[int], chunk: int = 24) -> None:
+        for a in range(0, len(words), chunk):
+            r = await self.command(cmd_w(ch, base + a, words[a:a + chunk]))
+            assert r == b"K", f"W ch{ch} @{base + a}: reply {r!r}"
+
+
+class Video:
+    """Samples the TMDS symbols every clock and decodes them (tmds.decode)."""
+
+    def __init__(self, dut, g):
+        self.dut, self.g = dut, g
+        self.samples: list[tuple[int, int, int]] = []
+        self.on = False
+        cocotb.start_soon(self._run())
+
+    async def _run(self) -> None:
+        dut = self.dut
+        while True:
+            await RisingEdge(dut.clk_i)
+            if self.on:
+                await ReadOnly()
+                v = int(dut.tmds_o.value)
+                self.samples.append((v & 0x3FF, (v >> 10) & 0x3FF, (v >> 20) & 0x3FF))
+
+    def frames(self) -> list[np.ndarray]:
+        """Complete frames (VActive x HActive x RGB), with every sync check on the way."""
+        g = self.g
+        lines, frames = [], []
+        cur = None            # pixels of the DE run in progress
+        prev_hs = prev_vs = None
+        hs_start = hs_len = None
+        last_hs_edge = None
+        de_end = None
+        started = False       # a vsync edge has been seen (frames start after it)
+        for t, syms in enumerate(self.samples):
+            dec = [tmds.decode(s) for s in syms]
+            kinds = {k for k, _ in dec}
+            assert len(kinds) == 1, f"t={t}: channels disagree on DE: {dec}"
+            if "data" in kinds:
+                if cur is None:
+                    cur = []
+                cur.append((dec[2][1], dec[1][1], dec[0][1]))   # R, G, B
+                continue
+            assert dec[1][1] == 0 and dec[2][1] == 0, f"t={t}: C on green/red: {dec}"
+            if cur is not None:
+                assert len(cur) == g["TestHActive"], f"t={t}: DE run of {len(cur)}"
+                lines.append(cur)
+                cur = None
+                de_end = t
+            hs = not (dec[0][1] & 1)          # test mode: negative polarity
+            vs = not (dec[0][1] & 2)
+            if hs and prev_hs is False:
+                if de_end is not None and t - de_end < g["HTotal"]:
+                    assert t - de_end == g["TestHFp"], f"t={t}: hsync {t - de_end} after DE"
+                if last_hs_edge is not None:
+                    assert t - last_hs_edge == g["HTotal"], f"t={t}: hsync period"
+                last_hs_edge = t
+                hs_start = t
+            if not hs and prev_hs and hs_start is not None:
+                hs_len = t - hs_start
+                assert hs_len == g["TestHSync"], f"t={t}: hsync {hs_len} wide"
+            if vs and prev_vs is False:
+                if started:
+                    assert len(lines) == g["TestVActive"], f"t={t}: frame of {len(lines)} lines"
+                    frames.append(np.array(lines, dtype=np.uint8))
+                started = True
+                lines = []
+            prev_hs, prev_vs = hs, vs
+        return frames
+
+
+async def reset(dut, g):
+    cocotb.start_soon(Clock(dut.clk_i, 40, unit="ns").start())
+    dut.rst_i.value = 1
+    dut.mode_i.value = 3
+    dut.uart_rx_i.value = 1
+    await ClockCycles(dut.clk_i, 5)
+    await FallingEdge(dut.clk_i)
+    dut.rst_i.value = 0
+
+
+def check_switch(frames, old, new, what):
+    """Per colour: frames are old ... old, new ... new (one switch), ending on new."""
+    for c in range(NCH):
+        seq = []
+        for i, f in enumerate(frames):
+            is_old, is_new = np.array_equal(f[:, :, c], old[c]), np.array_equal(f[:, :, c], new[c])
+            assert is_old or is_new, (
+                f"{what}: frame {i} colour {c} is neither image:\n{f[:, :, c]}\n"
+                f"old:\n{old[c]}\nnew:\n{new[c]}")
+            seq.append("n" if is_new and not is_old else "o" if is_old and not is_new else "?")
+        if np.array_equal(old[c], new[c]):
+            continue   # unchanged colour: every frame equals it (checked above)
+        s = "".join(seq).replace("?", "")
+        assert s.endswith("n") and "no" not in s, f"{what}: colour {c} sequence {''.join(seq)}"
+
+
+@cocotb.test()
+async def test_load_and_play(dut):
+    from common.run import seed_from_env
+    seed = seed_from_env()
+    rng = random.Random(seed)
+    g = geom(dut)
+    await reset(dut, g)
+    host = Host(dut, g)
+    video = Video(dut, g)
+    ftime = g["HTotal"] * g["VTotal"]
+
+    # Images: one per colour, windows 2/0/4, compensation on R and G (carry bug is on).
+    windows, comps = [2, 0, 4], [True, True, False]
+    de32 = []
+    for c in range(NCH):
+        cmds = make_image(rng, g, windows[c], max_words=g["HTotal"] - 4)
+        words = binfmt.framestore_encode(cmds, windows[c])
+        de32.append(binfmt.encode_de32(words, windows[c], comps[c]))
+    shift, sat = 1, True
+
+    # Before any load: black frames.
+    video.on = True
+    await ClockCycles(dut.clk_i, 3 * ftime)
+    black = [np.zeros((g["TestVActive"], g["n_pe"]), np.uint8)] * NCH
+    pre = video.frames()
+    assert pre, "no frame before loading"
+    for f in pre:
+        assert not f.any(), "frame not black before loading"
+
+    # Output window, then the errors the loader must report.
+    assert await host.command(with_chk(b"O" + bytes([shift, int(sat)]))) == b"K"
+    w0 = binfmt.decode_de32(de32[2])[0]
+    bad = bytearray(cmd_w(2, 0, w0[:4]))
+    bad[-1] ^= 0x5A
+    assert await host.command(bytes(bad)) == b"E", "checksum error not reported"
+    await host.send(b"\x00")                               # garbage between commands
+    r = await host.command(cmd_w(2, 0, w0[:4]), bad_stop_at=9,
+                           timeout=(1 << g["TimeoutBits"]) + 400 * g["ClkPerBit"])
+    assert r == b"T", f"framing error inside a command: reply {r!r}, want T (abandoned)"
+
+    # Load the three images, then their descriptors.
+    for c in range(NCH):
+        words, window, comp = binfmt.decode_de32(de32[c])
+        await host.load(c, 0, words)
+    for c in range(NCH):
+        words, window, comp = binfmt.decode_de32(de32[c])
+        assert await host.command(cmd_p(c, 0, len(words), window, comp)) == b"K"
+    await ClockCycles(dut.clk_i, 6 * ftime)
+    new = [golden(d, g, shift, sat) for d in de32]
+    assert sum(int(np.count_nonzero(p)) for p in new) > 0, "golden image all black: no test"
+    frames = video.frames()[len(pre):]
+    check_switch(frames, black, new, "first image")
+    n_first = len(frames)
+
+    # Double buffering: a second red image at base 128, switched in by its descriptor.
+    cmds2 = make_image(rng, g, 3, max_words=g["HTotal"] - 4)
+    words2 = binfmt.framestore_encode(cmds2, 3)
+    de32_2 = binfmt.encode_de32(words2, 3, False)
+    await host.load(0, 128, words2)
+    assert await host.command(cmd_p(0, 128, len(words2), 3, False)) == b"K"
+    await ClockCycles(dut.clk_i, 5 * ftime)
+    new2 = [golden(de32_2, g, shift, sat)] + new[1:]
+    frames2 = video.frames()[len(pre) + n_first:]
+    check_switch(frames2, new, new2, "second image")
+
+    # Status and registers over the UART.
+    n_video = len(video.frames())       # frames shown before the status request
+    st = await host.command(with_chk(b"S"), n_reply=16)
+    assert st[0] == ord("S") and st[1] == 1 and st[2] == g["NumChips"], st
+    assert st[3] == (g["FsDepth"] - 1).bit_length()
+    ferr, cerr, kerr, nfr = (int.from_bytes(st[k:k + 2], "big") for k in (4, 6, 8, 10))
+    assert (ferr, cerr, kerr) == (1, 1, 2), (
+        f"error counters framing/checksum/command = {ferr}/{cerr}/{kerr}, want 1/1/2")
+    assert st[12] == 0, f"flags {st[12]:#x}: align_err / collision / pending set"
+    assert st[13] == (int(sat) << 3 | shift)
+    assert nfr >= n_video, f"player frames {nfr} < displayed {n_video}"
+    regs = {}
+    for name, addr in [("id", 0x3000)] + [(f"late{c}", c << 12 | 0x00A) for c in range(NCH)] \
+            + [(f"drop{c}", c << 12 | 0x009) for c in range(NCH)] + [("frames0", 0x001)]:
+        r = await host.command(with_chk(b"R" + addr.to_bytes(2, "big")), n_reply=5)
+        assert r[0] == ord("R"), r
+        regs[name] = int.from_bytes(r[1:], "big")
+    assert regs["id"] == (0xDC << 24 | 3 << 20 | 1 << 16 | (g["NumChips"] + 3)), hex(regs["id"])
+    for c in range(NCH):
+        assert regs[f"late{c}"] == 0 and regs[f"drop{c}"] == 0, regs
+    assert regs["frames0"] >= n_video - 1, regs
+    dut._log.info(f"board top: {n_first} + {len(frames2)} frames after the loads match the "
+                  f"golden model; status {ferr}/{cerr}/{kerr} errors, {nfr} frames played, "
+                  f"registers {dict((k, hex(v)) for k, v in regs.items())}")
+
+
+# ====================================================================== pytest runners
+BOARD = dict(NumChips=1, CarryBug=1, FsDepth=256, ClkPerBit=8, TimeoutBits=11,
+             BufDepth=16, MaxLines=8, TestHActive=9, TestHFp=2, TestHSync=3, TestHBp=3,
+             TestVActive=6, TestVFp=1, TestVSync=2, TestVBp=2)
+
+
+def board_sources():
+    from common.run import RTL
+    return [RTL / p for p in (
+        "xproc/de_pkg.sv", "xproc/de_pe.sv", "proto/de_skew.sv", "proto/de_deskew.sv",
+        "proto/de_instr_lut.sv", "proto/de_data_mapper.sv", "array/de_chip.sv",
+        "array/de_array.sv", "ctrl/de_instr_buffer.sv", "ctrl/de_video_timing.sv",
+        "ctrl/de_access_ctrl.sv", "ctrl/de_load_monitor.sv", "ctrl/de_display_core.sv",
+        "ctrl/display_controller.sv", "board/de_uart_rx.sv", "board/de_uart_tx.sv",
+        "board/de_loader.sv", "board/de_fs_player.sv", "board/de_tmds_enc.sv",
+        "board/de_board_core.sv")]
+
+
+def test_tmds():
+    from common.run import RTL, build_and_test
+    build_and_test(HERE, "de_tmds_enc", [RTL / "board" / "de_tmds_enc.sv"],
+                   "test_board_top", testcase="test_tmds_encoder")
+
+
+def test_board():
+    from common.run import build_and_test
+    build_and_test(HERE, "de_board_core", board_sources(), "test_board_top",
+                   parameters=BOARD, testcase="test_load_and_play")
