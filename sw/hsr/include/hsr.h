@@ -246,7 +246,9 @@ typedef struct yp_line_stats {
     int patterns;            /* visible patterns (pattern rows) on the line */
     int partial;             /* partly covered pixels (one Eval1 each, per colour) */
     int degraded[3];         /* patterns whose colour function was lowered */
-    int overflow[3];         /* 1 if even flat shading did not fit */
+    int merged[3];           /* 1: even Eval1 per pattern did not fit; the line is
+                              * one spline through the exact values (tolerance raised) */
+    int overflow[3];         /* 1 if even that did not fit (the controller drops it) */
 } yp_line_stats;
 
 typedef struct yp_frame {

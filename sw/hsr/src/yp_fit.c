@@ -35,17 +35,63 @@ void yp_eval_values(int order, const int64_t *v0, int n, const int *knot_pos,
 
 static int ok_at(double v, double f, double tol, int clamp)
 {
-    if (clamp && f <= tol && v <= 0) return 1;
+    if (clamp && f <= tol && v <= 0) return v >= -2047;
     return fabs(v - f) <= tol;
 }
 
 static double binom(int t, int p) { return p == 0 ? 1 : p == 1 ? t : 0.5 * t * (t - 1); }
+
+/* Scan one segment from k with lower differences v: returns the first
+ * pixel e where no highest difference fits (n if none), and the feasible
+ * interval [lo, hi] of the highest difference for the pixels before e. */
+static int segment(const double *f, const unsigned char *use, int n, int order, double T, double tol,
+                   int clamp, int k, const int64_t *v, double *lo_out, double *hi_out)
+{
+    const double S = YP_ONE;
+    double lo = -INFINITY, hi = INFINITY;
+    int e = n;
+    for (int t = order; k + t < n; t++) {
+        int x = k + t;
+        if (!use[x]) continue;
+        double B = binom(t, order), base = 0;
+        for (int r = 0; r < order; r++) base += (double)v[r] * binom(t, r);
+        /* with Acc_mode a value below 0 counts as 0, but it must not wrap
+         * (the 36-bit A holds -2048 .. 2048 pixel units) */
+        double tgt = f[x] * S, flo = (clamp && f[x] <= tol) ? -2000.0 * S : tgt - T, fhi = tgt + T;
+        double nlo = ceil((flo - base) / B), nhi = floor((fhi - base) / B);
+        if (nlo < lo) nlo = lo;
+        if (nhi > hi) nhi = hi;
+        if (nlo > nhi) { e = x; break; }
+        lo = nlo; hi = nhi;
+    }
+    *lo_out = lo; *hi_out = hi;
+    return e;
+}
+
+/* 1 if highest difference c from segment start k (lower differences v)
+ * keeps every constrained pixel k .. p within tol */
+static int check(const double *f, const unsigned char *use, int order, double T, double tol, int clamp,
+                 int k, const int64_t *v, double c, int p)
+{
+    const double S = YP_ONE;
+    for (int t = order; k + t <= p; t++) {
+        int x = k + t;
+        if (!use[x]) continue;
+        double val = c * binom(t, order);
+        for (int r = 0; r < order; r++) val += (double)v[r] * binom(t, r);
+        double tgt = f[x] * S;
+        if (clamp && f[x] <= tol) { if (val > tgt + T || val < -2000.0 * S) return 0; }
+        else if (fabs(val - tgt) > T) return 0;
+    }
+    return 1;
+}
 
 int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, double tol,
            int clamp, yp_cmdlist *out)
 {
     if (n <= 0 || order < 0 || order > 2) return -1;
     const double S = YP_ONE, T = tol * S * (1 - 1e-9);
+    (void)S;
     int *kp = malloc(sizeof(int) * (size_t)(n + 1));
     int64_t *kc = malloc(sizeof(int64_t) * (size_t)(n + 1));
     int64_t *val = malloc(sizeof(int64_t) * (size_t)n);
@@ -58,22 +104,41 @@ int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, 
     int64_t v[3] = {v0[0], v0[1], 0};          /* differences at segment start k */
     int nk = 0, k = 0;
     for (;;) {
-        double lo = -INFINITY, hi = INFINITY;
-        int e = n;
-        for (int t = order; k + t < n; t++) {
-            int x = k + t;
-            if (!use[x]) continue;
-            double B = binom(t, order), base = 0;
-            for (int r = 0; r < order; r++) base += (double)v[r] * binom(t, r);
-            double tgt = f[x] * S, flo = (clamp && f[x] <= tol) ? -INFINITY : tgt - T, fhi = tgt + T;
-            double nlo = ceil((flo - base) / B), nhi = floor((fhi - base) / B);
-            if (nlo < lo) nlo = lo;
-            if (nhi > hi) nhi = hi;
-            if (nlo > nhi) { e = x; break; }
-            lo = nlo; hi = nhi;
+        double lo, hi, c;
+        int e;
+        if (order == 0) {
+            e = segment(f, use, n, order, T, tol, clamp, k, v, &lo, &hi);
+            c = isfinite(lo) && isfinite(hi) ? floor(0.5 * (lo + hi)) : isfinite(lo) ? lo : isfinite(hi) ? hi : 0;
+        } else {
+            /* the segment's highest difference interpolates the target at
+             * its last pixel p (so the next segment starts with a small
+             * error in value and slope); take the longest segment whose
+             * pixels all lie within tol, looking a few pixels past the
+             * first failure */
+            int bestp = -1, fails = 0;
+            double bestc = 0;
+            for (int p = k + order; p < n && fails < 6; p++) {
+                if (!use[p]) continue;
+                int t = p - k;
+                double base = 0;
+                for (int r = 0; r < order; r++) base += (double)v[r] * binom(t, r);
+                double tgt = (clamp && f[p] <= tol) ? fmin(f[p] * S, 0) : f[p] * S;
+                double cc = round((tgt - base) / binom(t, order));
+                if (check(f, use, order, T, tol, clamp, k, v, cc, p)) { bestp = p; bestc = cc; fails = 0; }
+                else fails++;
+            }
+            if (bestp < 0) {     /* cannot happen: p = k + order is exact up to rounding */
+                e = segment(f, use, n, order, T, tol, clamp, k, v, &lo, &hi);
+                c = isfinite(lo) && isfinite(hi) ? floor(0.5 * (lo + hi)) : isfinite(lo) ? lo : isfinite(hi) ? hi : 0;
+            } else {
+                c = bestc;
+                /* the last constrained pixel decided by c: end of span or
+                 * bestp; beyond it the next knot */
+                int last = n - 1;
+                while (last > bestp && !use[last]) last--;
+                e = last == bestp ? n : bestp + 1;
+            }
         }
-        double c = isfinite(lo) && isfinite(hi) ? floor(0.5 * (lo + hi))
-                 : isfinite(lo) ? lo : isfinite(hi) ? hi : 0;
         if (nk == 0) v0[order] = (int64_t)c; else kc[nk - 1] = (int64_t)c;
         v[order] = (int64_t)c;
         if (e >= n) break;

@@ -237,20 +237,40 @@ static hsr_status finish_line(scan *s, int y, int c)
     int cost = line_cost(L->e, n, &sp);
     ls->degraded[c] = 0;
     for (int i = 0; i < n; i++) if (L->e[i]->lev < L->e[i]->maxlev) ls->degraded[c]++;
-    ls->overflow[c] = cost > s->o->capacity;
     yp_cmdlist *out = &s->fr->line[c * s->H + y];
     yp_cmdlist_free(out);
-    yp_cmd bg = {YP_EVAL, 0, 0, (uint16_t)s->W, {q24(s->sh->bg[c] + 0.5), 0, 0}};
-    hsr_status st = yp_cmdlist_push(out, bg);
-    for (int i = 0; i < n && st == HSR_OK; i++) {
-        st = append(out, &L->e[i]->lv[L->e[i]->lev]);
+    hsr_status st = HSR_OK;
+    ls->merged[c] = ls->overflow[c] = 0;
+    if (cost > s->o->capacity) {
+        /* Even Eval1 for every pattern does not fit: the last resort
+         * before dropping anything is one spline for the whole line
+         * through the exact target values, with a tolerance raised until
+         * it fits (every pattern still contributes; the line is reported). */
+        double *f = s->tmp;
+        unsigned char *use = s->use2;
+        const double *id = &s->fr->ideal[((size_t)c * s->H + y) * s->W];
+        for (int x = 0; x < s->W; x++) { f[x] = id[x] + 0.5; use[x] = 1; }
+        for (double tol = 4 * s->o->tol; tol < 8192; tol *= 2) {
+            yp_cmdlist_free(out);
+            if (yp_fit(f, use, s->W, 0, 2, tol, 0, out) < 0) { st = HSR_ELIMIT; break; }
+            if (out->slots <= s->o->capacity) break;
+        }
+        ls->merged[c] = 1;
+        ls->degraded[c] = n;
+        ls->overflow[c] = out->slots > s->o->capacity;
+        goto stats;
     }
+    yp_cmd bg = {YP_EVAL, 0, 0, (uint16_t)s->W, {q24(s->sh->bg[c] + 0.5), 0, 0}};
+    st = yp_cmdlist_push(out, bg);
+    for (int i = 0; i < n && st == HSR_OK; i++)
+        st = append(out, &L->e[i]->lv[L->e[i]->lev]);
     if (sp && st == HSR_OK) {
         yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}};
         st = yp_cmdlist_push(out, am);
         for (int i = 0; i < n && st == HSR_OK; i++)
             if (L->e[i]->lev == 3) st = append(out, &L->e[i]->spec);
     }
+stats:
     ls->cmds[c] = out->n; ls->slots[c] = out->slots;
     if (c == 0) {
         ls->patterns = n; ls->partial = 0;

@@ -64,21 +64,21 @@ static int mkdir_p(const char *d)
 
 static const char *shading_name(yp_shading s) { return s == YP_FLAT ? "flat" : s == YP_GOURAUD ? "gouraud" : "phong"; }
 
-typedef struct totals { long slots[3]; int maxslots[3], lines_degraded, lines_overflow, patterns_degraded; } totals;
+typedef struct totals { long slots[3]; int maxslots[3], lines_degraded, lines_merged, lines_overflow, patterns_degraded; } totals;
 
 static void frame_totals(const yp_frame *fr, totals *t)
 {
     memset(t, 0, sizeof *t);
     for (int y = 0; y < fr->height; y++) {
         const yp_line_stats *s = &fr->st[y];
-        int deg = 0, ov = 0;
+        int deg = 0, ov = 0, mg = 0;
         for (int c = 0; c < 3; c++) {
             t->slots[c] += s->slots[c];
             if (s->slots[c] > t->maxslots[c]) t->maxslots[c] = s->slots[c];
-            deg |= s->degraded[c] > 0; ov |= s->overflow[c];
+            deg |= s->degraded[c] > 0; ov |= s->overflow[c]; mg |= s->merged[c];
             t->patterns_degraded += s->degraded[c];
         }
-        t->lines_degraded += deg; t->lines_overflow += ov;
+        t->lines_degraded += deg; t->lines_overflow += ov; t->lines_merged += mg;
     }
 }
 
@@ -132,12 +132,12 @@ static void stats_frame_json(FILE *f, const yp_frame *fr, const opts *o, const c
     totals t;
     frame_totals(fr, &t);
     fprintf(f, "%s\"totals\": {\"slots\": [%ld, %ld, %ld], \"max_slots\": [%d, %d, %d], "
-               "\"mean_slots\": [%.2f, %.2f, %.2f], \"lines_degraded\": %d, \"lines_overflow\": %d, "
+               "\"mean_slots\": [%.2f, %.2f, %.2f], \"lines_degraded\": %d, \"lines_merged\": %d, \"lines_overflow\": %d, "
                "\"patterns_degraded\": %d, \"evals\": {\"eval0\": %d, \"eval1\": %d, \"eval2\": %d, \"eval3\": %d}, "
                "\"knots\": %d, \"dis\": %d, \"partial_pixels\": %d, \"specular_evals\": %d}",
             indent, t.slots[0], t.slots[1], t.slots[2], t.maxslots[0], t.maxslots[1], t.maxslots[2],
             (double)t.slots[0] / fr->height, (double)t.slots[1] / fr->height, (double)t.slots[2] / fr->height,
-            t.lines_degraded, t.lines_overflow, t.patterns_degraded, fr->n_eval[0], fr->n_eval[1], fr->n_eval[2],
+            t.lines_degraded, t.lines_merged, t.lines_overflow, t.patterns_degraded, fr->n_eval[0], fr->n_eval[1], fr->n_eval[2],
             fr->n_eval[3], fr->n_knots, fr->n_dis, fr->n_partial, fr->n_spec);
     (void)o;
 }
@@ -159,10 +159,10 @@ static int write_stats(const char *dir, const yp_frame *fr, const opts *o, const
     for (int y = 0; y < fr->height; y++) {
         const yp_line_stats *s = &fr->st[y];
         fprintf(f, "%s\n  {\"y\": %d, \"cmds\": [%d, %d, %d], \"slots\": [%d, %d, %d], \"patterns\": %d, "
-                   "\"partial\": %d, \"degraded\": [%d, %d, %d], \"overflow\": [%d, %d, %d]}",
+                   "\"partial\": %d, \"degraded\": [%d, %d, %d], \"merged\": [%d, %d, %d], \"overflow\": [%d, %d, %d]}",
                 y ? "," : "", y, s->cmds[0], s->cmds[1], s->cmds[2], s->slots[0], s->slots[1], s->slots[2],
                 s->patterns, s->partial, s->degraded[0], s->degraded[1], s->degraded[2],
-                s->overflow[0], s->overflow[1], s->overflow[2]);
+                s->merged[0], s->merged[1], s->merged[2], s->overflow[0], s->overflow[1], s->overflow[2]);
     }
     fprintf(f, "\n]}\n");
     return fclose(f) == 0 ? 0 : 1;
@@ -204,13 +204,14 @@ static int scan_main(opts *o)
         totals t;
         frame_totals(fr, &t);
         printf("yproc scan %s: %dx%d %s %s, %d faces, %d LLR domains; slots/line r/g/b mean %.0f/%.0f/%.0f max %d/%d/%d "
-               "of %d; lines degraded %d, overflow %d; hsr %.1f ms, scan %.1f ms/frame, write %.1f ms\n",
+               "of %d; lines degraded %d (merged %d), overflow %d; hsr %.1f ms, scan %.1f ms/frame, write %.1f ms\n",
                o->in, fr->width, fr->height, shading_name(o->yo.shading), o->yo.aa ? "aa" : "no-aa", sc->nf, nvis,
                (double)t.slots[0] / fr->height, (double)t.slots[1] / fr->height, (double)t.slots[2] / fr->height,
-               t.maxslots[0], t.maxslots[1], t.maxslots[2], o->yo.capacity, t.lines_degraded, t.lines_overflow,
+               t.maxslots[0], t.maxslots[1], t.maxslots[2], o->yo.capacity, t.lines_degraded, t.lines_merged, t.lines_overflow,
                t2 - t1, (t3 - t2) / o->frames, t4 - t3);
+        fflush(stdout);
         if (t.lines_overflow)
-            fprintf(stderr, "yproc: warning: %d line(s) exceed %d slots even with flat shading (see stats.json)\n",
+            fprintf(stderr, "yproc: warning: %d line(s) exceed %d slots even as one spline per line (see stats.json)\n",
                     t.lines_overflow, o->yo.capacity);
     }
     yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); hsr_scene_free(sc);
