@@ -15,7 +15,7 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: help setup demo test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: fuzz-hsr help setup demo test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        render the shipped default command file to out/demo.png"
@@ -27,6 +27,7 @@ help:
 	@echo "make lint        verilator -Wall and verible lint on every RTL file"
 	@echo "make fpga        yosys + nextpnr: one 9-PE chip on ECP5 and iCE40, 640-PE fit (fpga/)"
 	@echo "make bench-hsr   HSR benchmarks (Table 5.2, Fig 5.30) into docs/performance.md"
+	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
 	@echo "make setup       create .venv from scripts/requirements.txt"
 	@echo "make clean       remove build products (keeps .venv)"
 
@@ -47,7 +48,12 @@ test-py: $(SETUP)
 	$(ENV) cd sw && $(PY) -m pytest -q -n 2 tests
 
 test-c:
-	@if [ -f sw/hsr/Makefile ]; then $(MAKE) -C sw/hsr test; fi
+	$(MAKE) -C sw/hsr test
+	$(MAKE) -C sw/hsr/fuzz smoke
+
+# Coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang; FUZZ_SECONDS each).
+fuzz-hsr:
+	$(MAKE) -C sw/hsr/fuzz long
 
 test-rtl: $(SETUP)
 	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 .; fi

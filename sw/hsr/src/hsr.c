@@ -31,7 +31,10 @@ static void iv_del(ivec *a, int x)
     a->n--;
 }
 
-typedef struct mlr { int present; hsr_domain *dom; hsr_plane plane; double opacity; ivec vis, invis; } mlr;
+/* mark_par / mark_acc: stamps for O(1) duplicate tests while one parent list or
+ * one accumulated list is being built (iv_find there made long lists O(n^2)). */
+typedef struct mlr { int present; hsr_domain *dom; hsr_plane plane; double opacity; ivec vis, invis;
+                     unsigned mark_par, mark_acc; } mlr;
 typedef struct llr { int used; hsr_domain *dom; ivec par; int nvis; } llr;
 
 struct hsr_ctx {
@@ -40,7 +43,17 @@ struct hsr_ctx {
     mlr *m; int nm, capm;
     llr *l; int nl, capl;
     ivec freel;
+    unsigned stamp;
 };
+
+static unsigned next_stamp(hsr_ctx *h)
+{
+    if (++h->stamp == 0) {   /* wrapped: forget every old mark */
+        for (int i = 0; i < h->nm; i++) h->m[i].mark_par = h->m[i].mark_acc = 0;
+        h->stamp = 1;
+    }
+    return h->stamp;
+}
 
 #define OPAQUE(h, id) ((h)->m[id].opacity >= 1.0)
 
@@ -89,10 +102,15 @@ static hsr_status llr_create(hsr_ctx *h, hsr_domain *dom, const int *pre, int np
     llr *L = &h->l[s];
     L->used = 1; L->dom = dom; L->par.n = 0; L->nvis = npre;
     int ok = 1;
-    for (int i = 0; i < npre && ok; i++) ok = iv_push(&L->par, pre[i]) && iv_add(&h->m[pre[i]].vis, s);
+    unsigned mark = next_stamp(h);
+    for (int i = 0; i < npre && ok; i++) {
+        h->m[pre[i]].mark_par = mark;
+        ok = iv_push(&L->par, pre[i]) && iv_add(&h->m[pre[i]].vis, s);
+    }
     for (int i = 0; tail && i < tail->n && ok; i++) {
         int t = tail->v[i];
-        if (iv_find(&L->par, t) >= 0 || !h->m[t].present) continue;
+        if (h->m[t].mark_par == mark || !h->m[t].present) continue;
+        h->m[t].mark_par = mark;
         ok = iv_push(&L->par, t) && iv_add(&h->m[t].invis, s);
     }
     if (!ok) return HSR_ENOMEM;
@@ -143,6 +161,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
     hsr_domain *rem = hsr_domain_clone(M->dom);
     ivec cand = {0, 0, 0}, acc = {0, 0, 0}, tail = {0, 0, 0};
     if (!rem) return HSR_ENOMEM;
+    unsigned acc_mark = next_stamp(h);
     hsr_gridlist_query(h->grid, rem->ext, collect, &cand);
     for (int ci = 0; ci < cand.n && !hsr_domain_is_empty(rem); ci++) {
         int s = cand.v[ci];
@@ -194,7 +213,12 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         memcpy(pre, N->par.v, sizeof(int) * (size_t)k);
         tail.n = 0;
         for (int i = k; i < N->par.n; i++) iv_push(&tail, N->par.v[i]);
-        if (c.covered) for (int i = 0; i < N->par.n; i++) if (!iv_add(&acc, N->par.v[i])) st = HSR_ENOMEM;
+        for (int i = 0; c.covered && i < N->par.n; i++) {
+            int p = N->par.v[i];
+            if (h->m[p].mark_acc == acc_mark) continue;
+            h->m[p].mark_acc = acc_mark;
+            if (!iv_push(&acc, p)) st = HSR_ENOMEM;
+        }
         llr_destroy(h, s);
         if (c.hidden) iv_add(&tail, id);
         if (!hsr_domain_is_empty(res[1])) { st = llr_create(h, res[1], pre, k, &tail); res[1] = NULL; }
