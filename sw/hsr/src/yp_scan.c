@@ -226,7 +226,7 @@ static hsr_status finish_line(scan *s, int y, int c)
     int n = L->n, sp;
     entry **ord = malloc(sizeof(entry *) * (size_t)(n + 1));
     if (!ord) return HSR_ENOMEM;
-    memcpy(ord, L->e, sizeof(entry *) * (size_t)n);
+    if (n) memcpy(ord, L->e, sizeof(entry *) * (size_t)n);
     qsort(ord, (size_t)n, sizeof(entry *), ent_area_cmp);
     /* section 7.5: lower the colour function of the least visible
      * patterns first, Eval3 -> Eval2 for all, then Eval2 -> Eval1 */
