@@ -148,13 +148,15 @@ body{font:13px/1.35 system-ui,sans-serif;margin:12px;color:#222}
 canvas{image-rendering:pixelated;border:1px solid #888;cursor:crosshair}
 #graph{border:1px solid #bbb;background:#fcfcfc}
 table{border-collapse:collapse;font:12px ui-monospace,monospace}
-td,th{border:1px solid #ddd;padding:1px 5px;text-align:right}td.l{text-align:left}
+td,th{border:1px solid #ddd;padding:1px 5px;text-align:right}td.l,th.l{text-align:left}
 #hover{color:#555;min-height:1.3em}.note{color:#a40}
 </style></head><body>
 <h2>__TITLE__</h2>
 <div id="meta"></div>
 <div id="wrap">
- <div><canvas id="img"></canvas><div id="hover"></div>
+ <div><div style="position:relative;line-height:0"><canvas id="img"></canvas>
+  <div id="mark" style="position:absolute;display:none;outline:2px solid #e53935;pointer-events:none"></div></div>
+  <div id="hover"></div>
   <label>display <select id="scale"><option value="max">scaled to frame max</option>
   <option value="12">12-bit full range</option></select></label></div>
  <div><svg id="graph" width="640" height="220" data-line=""></svg></div>
@@ -240,6 +242,9 @@ function row(tb, cells, attrs) {
 }
 cv.addEventListener("click", ev => {
   const [x, y] = where(ev); selected = [x, y];
+  const mk = document.getElementById("mark"), r = cv.getBoundingClientRect();
+  Object.assign(mk.style, {display: "block", left: (x * r.width / W) + "px", top: (y * r.height / H) + "px",
+                           width: Math.max(2, r.width / W) + "px", height: Math.max(2, r.height / H) + "px"});
   const sel = document.getElementById("sel");
   sel.textContent = `line ${y}, column ${x} (PE ${x}, chip ${Math.floor(x / 9)}): pixel ${pix(x, y)}`;
   sel.dataset.x = x; sel.dataset.y = y; sel.dataset.pixel = pix(x, y);

@@ -581,7 +581,8 @@ def _img(frame, caption: str, scale_hint: int) -> str:
         data = png(frame)
     h, w = frame.shape[:2]
     k = max(1, min(8, scale_hint // max(1, w)))
-    return (f'<figure><img src="{data_uri(data)}" width="{w * k}" height="{h * max(1, k)}" '
+    ky = min(64, max(k, -(-48 // max(1, h))))  # a one-line frame still gets 48 px
+    return (f'<figure><img src="{data_uri(data)}" width="{w * k}" height="{h * ky}" '
             f'alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}</figcaption></figure>')
 
 
@@ -596,7 +597,9 @@ def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds:
                     f"</td><td>{c.expect}</td><td>{v}</td><td>{r['n_lines']}</td>"
                     f"<td>{r['n_diff']}</td><td>{r['seconds']:.1f}</td></tr>")
     secs = []
-    order = sorted(cases, key=lambda c: verdict(c, results[c.name]) in GOOD)  # failures first
+    # unexpected results first, then the analysed expected failure, then the rest
+    order = sorted(cases, key=lambda c: (verdict(c, results[c.name]) in GOOD,
+                                         "trace" not in results[c.name]))
     for c in order:
         r = results[c.name]
         v = verdict(c, r)
@@ -666,7 +669,9 @@ def run(cases: list[Case], out: Path, jobs: int = 2, waves: bool = True, tier: s
         for c in cases:
             results[c.name] = r = futs[c.name].result()
             log(f"  {verdict(c, r):5s} {c.name}  {r['message'][:90]}")
-    example = next((c.name for c in cases if verdict(c, results[c.name]) == "XFAIL"), None)
+    # the expected failure analysed as an example: the smallest array (cheapest trace build)
+    xf = [c for c in cases if verdict(c, results[c.name]) == "XFAIL"]
+    example = min(xf, key=lambda c: (c.chips, c.name)).name if xf else None
     for c in cases:
         r = results[c.name]
         if r.get("first") is None or not (verdict(c, r) != "XFAIL" or c.name == example):
