@@ -44,7 +44,11 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE.parent.parent / "sw"))
 
+sys.path.insert(0, str(HERE.parent.parent / "fpga" / "ulx3s"))
+
 import tmds  # noqa: E402
+# The host tool's command encoders: the test checks them against the RTL too.
+from de32_load import cmd_p, cmd_w, with_chk  # noqa: E402
 from diffengine import binfmt, functional, isa, randgen  # noqa: E402
 
 NCH = 3
@@ -191,20 +195,6 @@ def golden(de32: bytes, g: dict, shift: int, sat: bool) -> np.ndarray:
     pix = functional.render(cmds, width=g["n_pe"], carry_bug=bool(g["CarryBug"]))
     assert pix.shape == (g["TestVActive"], g["n_pe"])
     return np.vectorize(lambda p: out8(int(p), shift, sat))(pix).astype(np.uint8)
-
-
-def with_chk(body: bytes) -> bytes:
-    return body + bytes([(-sum(body)) & 0xFF])
-
-
-def cmd_w(ch: int, addr: int, words: list[int]) -> bytes:
-    return with_chk(b"W" + bytes([ch]) + addr.to_bytes(2, "big") + len(words).to_bytes(2, "big")
-                    + b"".join(x.to_bytes(4, "big") for x in words))
-
-
-def cmd_p(ch: int, base: int, n: int, window: int, comp: bool) -> bytes:
-    return with_chk(b"P" + bytes([ch]) + base.to_bytes(2, "big") + n.to_bytes(2, "big")
-                    + bytes([window, int(comp)]))
 
 
 class Host:
