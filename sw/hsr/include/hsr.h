@@ -274,4 +274,18 @@ void yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix);
 hsr_status yp_write_de48(const yp_frame *fr, int colour, const char *path);
 hsr_status yp_write_cmd(const yp_frame *fr, int colour, const char *path);
 
+/* ---- animation (yproc anim, docs/yproc.md "Animation scenes") ------ */
+typedef struct yp_anim yp_anim;
+/* Reads an animation file (base scene + per-frame changes). */
+hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errlen);
+void yp_anim_free(yp_anim *a);
+int yp_anim_frames(const yp_anim *a);
+hsr_scene *yp_anim_scene(yp_anim *a);          /* the live scene (frame last applied) */
+/* Set the scene to frame f.  With h != NULL also update the HSR
+ * incrementally (hsr_move of the moved faces, hsr_set_opacity) and the
+ * shader; *y0, *y1 receive the lines that may have changed (y0 == y1:
+ * none).  With h == NULL only the scene changes (for a full rebuild). */
+hsr_status yp_anim_apply(yp_anim *a, int f, hsr_ctx *h, yp_shader *sh, int *y0, int *y1);
+int yp_cmdlist_equal(const yp_cmdlist *a, const yp_cmdlist *b);
+
 #endif
