@@ -465,7 +465,7 @@ def trace_compare(case: Case, commands, line: int, col: int) -> str:
     d = trace.first_difference(r.rows, m.rows)
     head = (f"diffengine trace stream.cmd --chips {case.chips} --bug {int(case.bug)} "
             f"--model-bug 0 --compare --line {line} --pes {pes[0]}-{pes[-1]}\n"
-            f"RTL (bug {int(case.bug)}) vs structural model (bug 0), cycles {lo}..{hi}: ")
+            f"RTL (bug {int(case.bug)}) vs structural model (bug 0), cycles {lo}..{hi}:\n")
     if d is None:
         return head + ("identical: the RTL does what the structural model does on this "
                        "line, so the difference lies in the reference")
@@ -586,6 +586,28 @@ def _img(frame, caption: str, scale_hint: int) -> str:
             f'alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}</figcaption></figure>')
 
 
+def line_svg(rtl: np.ndarray, ref: np.ndarray, y: int, x: int) -> str:
+    """The bad scanline, RTL (red) over the reference (blue), first bad column marked."""
+    w, gw, gh, m = rtl.shape[1], 640, 160, 30
+    top = max(1, int(max(rtl[y].max(), ref[y].max())))
+    X = lambda c: m + (c + 0.5) * (gw - m - 6) / w  # noqa: E731
+    Y = lambda v: gh - 16 - int(v) * (gh - 30) / top  # noqa: E731
+
+    def poly(row, colour, width):
+        pts = " ".join(f"{X(c - 0.5):.1f},{Y(v):.1f} {X(c + 0.5):.1f},{Y(v):.1f}"
+                       for c, v in enumerate(row.tolist()))
+        return (f'<polyline points="{pts}" fill="none" stroke="{colour}" '
+                f'stroke-width="{width}"/>')
+
+    return (f'<svg width="{gw}" height="{gh}" style="border:1px solid #ccc">'
+            + poly(ref[y], "#1565c0", 3) + poly(rtl[y], "#e53935", 1.2)
+            + f'<line x1="{X(x):.1f}" x2="{X(x):.1f}" y1="10" y2="{gh - 16}" stroke="#999" '
+            f'stroke-dasharray="3,3"/><text x="{gw / 2}" y="11" font-size="11" '
+            f'text-anchor="middle">scanline {y}: reference (blue), RTL (red), column {x} '
+            f'dashed</text><text x="2" y="22" font-size="10">{top}</text>'
+            f'<text x="2" y="{gh - 16}" font-size="10">0</text></svg>')
+
+
 def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds: float) -> str:
     e = html.escape
     rows = []
@@ -621,7 +643,7 @@ def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds:
                          f"{int(r['ref'][y, x])}</h4><p>Commands of line {y} acting on column "
                          f"{x} (stream index: command)</p><pre>"
                          + e("\n".join(f"{k:6d}: {t}" for k, t in r.get("touching", [])))
-                         + "</pre>")
+                         + "</pre>" + line_svg(r["rtl"], r["ref"], y, x))
             if r.get("trace"):
                 parts.append("<p>Where the RTL and the structural model part "
                              "(<code>diffengine trace --compare</code>):</p><pre>"
