@@ -87,6 +87,13 @@ def controller_setup(width: int, height: int, chips: int) -> tuple[int, tuple]:
     return 3, (width, 16, 96, H_TOTAL - width - 112, height, 1, 2, 2)
 
 
+def capacity(mode: int, test: tuple) -> int:
+    """Command slots a line can really use in the controller: HTotal - 2 (not HTotal - 1,
+    the window: the end-of-line marker must reach the buffer's head inside the window)."""
+    htotal = {0: 800, 1: 683, 2: 1688}.get(mode) or sum(test[:4])
+    return htotal - 2
+
+
 def build_yproc() -> Path:
     res = subprocess.run(["make", "-s", "-C", str(REPO / "sw" / "hsr"), "build/yproc"],
                          capture_output=True, text=True)
@@ -202,7 +209,10 @@ def run(scene, outdir, chips: int = 72, threads: int = 1, rtl: bool = True,
         + ("" if rtl else " (model only, --no-rtl)"))
     cmd_dir = outdir / f"{png_name}_cmd"
     t0 = time.monotonic()
-    ys = yproc_scan(scene, cmd_dir, aa=aa, shading=shading)
+    # A line of HTotal - 1 command slots is late: its marker reaches the buffer head only
+    # at the Refresh slot (docs/pipeline.md, "Line capacity"), so yproc gets HTotal - 2.
+    ys = yproc_scan(scene, cmd_dir, aa=aa, shading=shading,
+                    extra=("--capacity", str(capacity(mode, test))))
     stage("yproc scan (HSR+scan+shade)", ys["seconds"])
     rep["yproc"] = ys
     paths = [cmd_dir / f"{c}.de48" for c in "rgb"]

@@ -341,8 +341,12 @@ class _Raster:
 
 
 def render(sc: Scene, samples: int = 16, band: int = 16, quantise: bool = True,
-           progress=None) -> np.ndarray:
-    """The frame as float (H, W, 3) in pixel units (1.0 = 4095)."""
+           progress=None, info: dict | None = None) -> np.ndarray:
+    """The frame as float (H, W, 3) in pixel units (1.0 = 4095).
+
+    With `info` (a dict), info["edges"] is set to a bool (H, W) mask of the pixels whose
+    sub-samples do not all see the same front-most opaque triangle (or all background):
+    the pixels an edge crosses."""
     S = samples
     W, H = sc.width, sc.height
     P = project(sc, quantise)
@@ -355,6 +359,7 @@ def render(sc: Scene, samples: int = 16, band: int = 16, quantise: bool = True,
     eye, u, v, w, f = camera(sc)
     bg = np.array(sc.background, dtype=np.float64)
     out = np.zeros((H, W, 3))
+    edges = np.zeros((H, W), dtype=bool)
     alltri = np.flatnonzero(R.ok)
     for y0 in range(0, H, band):
         y1 = min(H, y0 + band)
@@ -433,6 +438,8 @@ def render(sc: Scene, samples: int = 16, band: int = 16, quantise: bool = True,
             return col
 
         zo, io, l1o, l2o = raster(tri[opaque[tri]])
+        blk = io.reshape(y1 - y0, S, W, S)
+        edges[y0:y1] = blk.min(axis=(1, 3)) != blk.max(axis=(1, 3))
         col = shade(zo, io, l1o, l2o)
         col[io < 0] = bg
         ttri = tri[~opaque[tri]]
@@ -454,11 +461,13 @@ def render(sc: Scene, samples: int = 16, band: int = 16, quantise: bool = True,
         out[y0:y1] = col.reshape(y1 - y0, S, W, S, 3).mean(axis=(1, 3))
         if progress:
             progress(y1, H)
+    if info is not None:
+        info["edges"] = edges
     return out * PIXEL_SCALE
 
 
-def render_file(path, samples: int = 16, progress=None) -> np.ndarray:
-    return render(load_scene(path), samples=samples, progress=progress)
+def render_file(path, samples: int = 16, progress=None, info: dict | None = None) -> np.ndarray:
+    return render(load_scene(path), samples=samples, progress=progress, info=info)
 
 
 def psnr(frame: np.ndarray, ref: np.ndarray, peak: float = PIXEL_SCALE) -> float:
