@@ -15,11 +15,12 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: fuzz-hsr help setup demo test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: sim fuzz-hsr help setup demo test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        render the shipped default command file to out/demo.png"
 	@echo "make test        run every test (sets itself up on first use)"
+	@echo "make sim         RTL regression vs golden model, HTML/JUnit reports (TIER=smoke|full|nightly J=2)"
 	@echo "make test-long   long random regressions (not part of make test)"
 	@echo "make bench       speed benchmarks, recorded in docs/performance.md"
 	@echo "make waves TEST=<cocotb test> [PE=p] [BUG=0|1]"
@@ -57,6 +58,12 @@ fuzz-hsr:
 
 test-rtl: $(SETUP)
 	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 .; fi
+
+# The RTL regression (docs/regression.md): TIER=smoke|full|nightly, J parallel jobs.
+TIER ?= full
+J ?= 2
+sim: $(SETUP)
+	$(ENV) cd sw && $(PY) -m diffengine.regress --tier $(TIER) -j $(J)
 
 # 10^7 random commands per array configuration through the RTL (hours on 2 cores).
 test-long: $(SETUP)
