@@ -44,7 +44,7 @@ static double binom(int t, int p) { return p == 0 ? 1 : p == 1 ? t : 0.5 * t * (
 /* Scan one segment from k with lower differences v: returns the first
  * pixel e where no highest difference fits (n if none), and the feasible
  * interval [lo, hi] of the highest difference for the pixels before e. */
-static int segment(const double *f, const unsigned char *use, int n, int order, double T, double tol,
+static int segment(const double *f, const unsigned char *use, const double *tolv, int n, int order, double T, double tol,
                    int clamp, int k, const int64_t *v, double *lo_out, double *hi_out)
 {
     const double S = YP_ONE;
@@ -57,7 +57,8 @@ static int segment(const double *f, const unsigned char *use, int n, int order, 
         for (int r = 0; r < order; r++) base += (double)v[r] * binom(t, r);
         /* with Acc_mode a value below 0 counts as 0, but it must not wrap
          * (the 36-bit A holds -2048 .. 2048 pixel units) */
-        double tgt = f[x] * S, flo = (clamp && f[x] <= tol) ? -2000.0 * S : tgt - T, fhi = tgt + T;
+        double Tx = tolv ? tolv[x] * S * (1 - 1e-9) : T;
+        double tgt = f[x] * S, flo = (clamp && f[x] <= tol) ? -2000.0 * S : tgt - Tx, fhi = tgt + Tx;
         double nlo = ceil((flo - base) / B), nhi = floor((fhi - base) / B);
         if (nlo < lo) nlo = lo;
         if (nhi > hi) nhi = hi;
@@ -70,7 +71,7 @@ static int segment(const double *f, const unsigned char *use, int n, int order, 
 
 /* 1 if highest difference c from segment start k (lower differences v)
  * keeps every constrained pixel k .. p within tol */
-static int check(const double *f, const unsigned char *use, int order, double T, double tol, int clamp,
+static int check(const double *f, const unsigned char *use, const double *tolv, int order, double T, double tol, int clamp,
                  int k, const int64_t *v, double c, int p)
 {
     const double S = YP_ONE;
@@ -79,14 +80,14 @@ static int check(const double *f, const unsigned char *use, int order, double T,
         if (!use[x]) continue;
         double val = c * binom(t, order);
         for (int r = 0; r < order; r++) val += (double)v[r] * binom(t, r);
-        double tgt = f[x] * S;
-        if (clamp && f[x] <= tol) { if (val > tgt + T || val < -2000.0 * S) return 0; }
-        else if (fabs(val - tgt) > T) return 0;
+        double tgt = f[x] * S, Tx = tolv ? tolv[x] * S * (1 - 1e-9) : T;
+        if (clamp && f[x] <= tol) { if (val > tgt + Tx || val < -2000.0 * S) return 0; }
+        else if (fabs(val - tgt) > Tx) return 0;
     }
     return 1;
 }
 
-int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, double tol,
+int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order, double tol,
            int clamp, yp_cmdlist *out)
 {
     if (n <= 0 || order < 0 || order > 2) return -1;
@@ -107,8 +108,12 @@ int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, 
         double lo, hi, c;
         int e;
         if (order == 0) {
-            e = segment(f, use, n, order, T, tol, clamp, k, v, &lo, &hi);
+            /* constant pieces: the target at the piece's first pixel if it
+             * fits all of them (exact for a constant colour), else the middle */
+            e = segment(f, use, tolv, n, order, T, tol, clamp, k, v, &lo, &hi);
             c = isfinite(lo) && isfinite(hi) ? floor(0.5 * (lo + hi)) : isfinite(lo) ? lo : isfinite(hi) ? hi : 0;
+            double first = round(f[k] * S);
+            if (use[k] && first >= lo && first <= hi) c = first;
         } else {
             /* the segment's highest difference interpolates the target at
              * its last pixel p (so the next segment starts with a small
@@ -124,11 +129,11 @@ int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, 
                 for (int r = 0; r < order; r++) base += (double)v[r] * binom(t, r);
                 double tgt = (clamp && f[p] <= tol) ? fmin(f[p] * S, 0) : f[p] * S;
                 double cc = round((tgt - base) / binom(t, order));
-                if (check(f, use, order, T, tol, clamp, k, v, cc, p)) { bestp = p; bestc = cc; fails = 0; }
+                if (check(f, use, tolv, order, T, tol, clamp, k, v, cc, p)) { bestp = p; bestc = cc; fails = 0; }
                 else fails++;
             }
             if (bestp < 0) {     /* cannot happen: p = k + order is exact up to rounding */
-                e = segment(f, use, n, order, T, tol, clamp, k, v, &lo, &hi);
+                e = segment(f, use, tolv, n, order, T, tol, clamp, k, v, &lo, &hi);
                 c = isfinite(lo) && isfinite(hi) ? floor(0.5 * (lo + hi)) : isfinite(lo) ? lo : isfinite(hi) ? hi : 0;
             } else {
                 c = bestc;
@@ -152,7 +157,7 @@ int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, 
     yp_eval_values(order, v0, n, kp, kc, nk, val);
     int bad = 0;
     for (int x = 0; x < n && !bad; x++)
-        if (use[x] && !ok_at((double)val[x] / S, f[x], tol, clamp)) bad = 1;
+        if (use[x] && !ok_at((double)val[x] / S, f[x], tolv ? tolv[x] : tol, clamp)) bad = 1;
     hsr_status st = HSR_OK;
     for (int i = 0; i < nk && st == HSR_OK; i++) {
         yp_cmd s = {(uint8_t)(YP_SETI + order), 0, (uint16_t)(x0 + kp[i]), 1, {kc[i], 0, 0}};

@@ -34,8 +34,8 @@ void yp_cover_ring(const double *xy, int n, double *acc, int nx, int ny);
  * don't care (use[0] must be 1).  clamp: Acc_mode is on (values that go
  * negative count as 0).  Appends the Sets and the Eval for the span
  * starting at column x0 to out (Sets first); returns knots or -1. */
-int yp_fit(const double *f, const unsigned char *use, int n, int x0, int order, double tol,
-           int clamp, yp_cmdlist *out);
+int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order,
+           double tol, int clamp, yp_cmdlist *out);   /* tolv: per-pixel tolerance or NULL */
 /* forward differencing of an order-p Eval with knots (value per column) */
 void yp_eval_values(int order, const int64_t *v0, int n, const int *knot_pos,
                     const int64_t *knot_c, int nk, int64_t *val);

@@ -24,7 +24,9 @@
 #include <string.h>
 #include "yp_internal.h"
 
-#define COV_Q 65536.0     /* coverage is rounded to 1/65536 of a pixel */
+#define COV_Q 65536.0     /* coverage is rounded to 2^-16 of a pixel: hides the sub-unit slivers in
+                           * which an incremental HSR result may differ from a rebuild */
+#define TOL_PARTIAL (1.0 / 64)  /* fit tolerance at partly covered pixels, pixel units */
 
 typedef struct entry {
     double area;
@@ -65,7 +67,7 @@ typedef struct scan {
     /* scratch */
     double *fb, *fs, *ft, *cov;  /* per column: base, spec (nl), total; coverage */
     unsigned char *use, *use2;
-    double *tmp;
+    double *tmp, *tolv;
 } scan;
 
 /* Dis over the runs of [a, b) where in[x - off] == 0 */
@@ -170,8 +172,12 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
                 f[x - a] = v;
             }
             double tol = o->tol * (e->maxlev == lev ? 1 : e->maxlev - lev == 1 ? 4 : 16);
+            /* partly covered pixels: a tight tolerance, so the pieces of a
+             * pixel shared by several patterns add up to its box average */
+            double *tv = s->tolv;
+            for (int x = a; x <= cl; x++) tv[x - a] = cov[x - x0] < 1 ? fmin(tol, TOL_PARTIAL) : tol;
             st = push_dis(&e->lv[lev], cv, a, a + n, a);
-            if (st == HSR_OK && yp_fit(f, cv, n, a, lev - 1, tol, 0, &e->lv[lev]) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK && yp_fit(f, cv, tv, n, a, lev - 1, tol, 0, &e->lv[lev]) < 0) st = HSR_ELIMIT;
             e->cost[lev] = e->lv[lev].slots;
         }
         for (int l = 0; l < nl && st == HSR_OK && nsep; l++) {
@@ -182,7 +188,7 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
                 if (full[x] && s->fs[3 * nl * x + 3 * l + c] > o->tol) { if (sa < 0) sa = x; sb = x; }
             for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
             st = push_dis(&e->spec, use, sa, sb + 1, sa);
-            if (st == HSR_OK && yp_fit(f, use, sb + 1 - sa, sa, 2, o->tol, 1, &e->spec) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK && yp_fit(f, use, NULL, sb + 1 - sa, sa, 2, o->tol, 1, &e->spec) < 0) st = HSR_ELIMIT;
         }
         if (st != HSR_OK) return st;
         e->spec_cost = e->spec.slots;
@@ -252,7 +258,7 @@ static hsr_status finish_line(scan *s, int y, int c)
         for (int x = 0; x < s->W; x++) { f[x] = id[x] + 0.5; use[x] = 1; }
         for (double tol = 4 * s->o->tol; tol < 8192; tol *= 2) {
             yp_cmdlist_free(out);
-            if (yp_fit(f, use, s->W, 0, 2, tol, 0, out) < 0) { st = HSR_ELIMIT; break; }
+            if (yp_fit(f, use, NULL, s->W, 0, 2, tol, 0, out) < 0) { st = HSR_ELIMIT; break; }
             if (out->slots <= s->o->capacity) break;
         }
         ls->merged[c] = 1;
@@ -304,7 +310,7 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     if (y0 < 0) y0 = 0;
     if (y1 > fr->height) y1 = fr->height;
     if (y0 >= y1) return HSR_OK;
-    scan s = {sh, o, fr, fr->width, fr->height, y0, y1, sh->nl, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+    scan s = {sh, o, fr, fr->width, fr->height, y0, y1, sh->nl, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     const int W = s.W;
     const double U = HSR_SUBPIXEL;
     hsr_status st = HSR_OK;
@@ -315,10 +321,11 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     s.fs = malloc(sizeof(double) * 3 * (size_t)(s.nl + 1) * (size_t)W);
     s.ft = malloc(sizeof(double) * 3 * (size_t)W);
     s.tmp = malloc(sizeof(double) * (size_t)W);
+    s.tolv = malloc(sizeof(double) * (size_t)W);
     s.use = malloc((size_t)W + 1); s.use2 = malloc(2 * (size_t)W + 2);
     double *acc = NULL;
     size_t acccap = 0;
-    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.tmp || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
+    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.tmp || !s.tolv || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
     for (int y = y0; y < y1; y++)
         for (int c = 0; c < 3; c++)
             for (int x = 0; x < W; x++) fr->ideal[((size_t)c * s.H + y) * W + x] = sh->bg[c];
@@ -406,6 +413,6 @@ done:
             free(s.le[i].e);
         }
     }
-    free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.use); free(s.use2);
+    free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.use); free(s.use2);
     return st;
 }

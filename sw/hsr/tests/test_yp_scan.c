@@ -229,7 +229,7 @@ static void test_yp_quadratic_fit_error_bound_against_exact_phong(void)
     for (int i = 0; i < N; i++) { f[i] = phong_at(i, N); use[i] = 1; }
     for (double tol = 0.5; tol <= 8; tol *= 4) {
         yp_cmdlist l = {0};
-        int nk = yp_fit(f, use, N, 20, 2, tol, 0, &l);
+        int nk = yp_fit(f, use, NULL, N, 20, 2, tol, 0, &l);
         CHECK(nk > 0 && l.n == nk + 1);
         yp_cmdlist line = {0};
         yp_cmd bg = {YP_EVAL, 0, 0, 640, {(int64_t)(0.5 * YP_ONE), 0, 0}};
@@ -252,7 +252,7 @@ static void test_yp_acc_mode_clamps_negative_specular_tails(void)
     unsigned char use[N];
     for (int i = 0; i < N; i++) { double d = (i - 100) / 12.0; f[i] = 2000 * exp(-d * d); use[i] = 1; }
     yp_cmdlist l = {0};
-    int nk = yp_fit(f, use, N, 0, 2, 2.0, 1, &l);
+    int nk = yp_fit(f, use, NULL, N, 0, 2, 2.0, 1, &l);
     CHECK(nk >= 0);
     /* the clamped fit may go below 0 where the highlight is ~0 ... */
     int64_t val[N];
