@@ -359,6 +359,74 @@ static void test_yp_de48_stream_layout(void)
     teardown(&t);
 }
 
+
+/* animation: incremental HSR + re-scan of the damaged lines gives, frame
+ * by frame, the same commands as a full rebuild, and lines outside the
+ * damage do not change */
+static void test_yp_anim_incremental_equals_full_rebuild(void)
+{
+    FILE *f = fopen("build/t_anim.obj", "w");
+    if (f) { fputs("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n", f); fclose(f); }
+    f = fopen("build/t_tri.obj", "w");
+    if (f) { fputs("v -0.5 -0.3 0.5\nv 0.4 -0.2 0.3\nv 0 0.5 0.4\nf 1 2 3\n", f); fclose(f); }
+    f = fopen("build/t_anim.scene", "w");
+    if (f) {
+        fputs("screen 48 36\ncamera eye 0 0 5 at 0 0 0 up 0 1 0 fov 40\nlight 0.3 0.4 1 0.6\nambient 0.2\n"
+              "background 0.1 0.1 0.1\nmaterial back 0.6 0.6 0.6 specular 0.2 20\nmaterial glass 0.2 0.5 0.8 opacity 0.5\n"
+              "obj t_anim.obj material back\nobj t_tri.obj material glass\n", f);
+        fclose(f);
+    }
+    f = fopen("build/t.anim", "w");
+    if (f) { fputs("scene t_anim.scene\nframes 6\nmove 1 0.6 0.2 0 from 0 to 3\nopacity glass 0.9 from 3 to 4\nlight 0 -1 0 1 from 4 to 5\n", f); fclose(f); }
+    char err[256] = "";
+    yp_anim *an = NULL;
+    CHECK(yp_anim_load("build/t.anim", &an, err, sizeof err) == HSR_OK);
+    if (!an) { fprintf(stderr, "%s\n", err); return; }
+    hsr_scene *sc = yp_anim_scene(an);
+    yp_shader *sh = NULL;
+    hsr_ctx *h = NULL;
+    double *shade;
+    yp_frame *fr = NULL;
+    yp_options o;
+    yp_options_default(&o);
+    CHECK(yp_anim_apply(an, 0, NULL, NULL, NULL, NULL) == HSR_OK);
+    CHECK(yp_shader_new(sc, YP_PHONG, &sh, err, sizeof err) == HSR_OK);
+    CHECK(hsr_scene_build(sc, &h, &shade) == HSR_OK);
+    free(shade);
+    CHECK(yp_frame_new(sc->width, sc->height, &fr) == HSR_OK);
+    CHECK(yp_scan(sh, h, &o, 0, sc->height, fr) == HSR_OK);
+    int H = sc->height, changed_outside = 0, full_damage = 0;
+    yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
+    for (int fnum = 1; fnum < yp_anim_frames(an); fnum++) {
+        for (int i = 0; i < 3 * H; i++) {
+            yp_cmdlist_free(&prev[i]);
+            for (int k = 0; k < fr->line[i].n; k++) yp_cmdlist_push(&prev[i], fr->line[i].c[k]);
+        }
+        int y0 = -1, y1 = -1;
+        CHECK(yp_anim_apply(an, fnum, h, sh, &y0, &y1) == HSR_OK);
+        CHECK(hsr_check(h) == HSR_OK);
+        CHECK(yp_scan(sh, h, &o, y0, y1, fr) == HSR_OK);
+        full_damage += y0 == 0 && y1 == H;
+        hsr_ctx *hf = NULL;
+        yp_frame *ff = NULL;
+        CHECK(hsr_scene_build(sc, &hf, &shade) == HSR_OK);
+        free(shade);
+        CHECK(yp_frame_new(sc->width, H, &ff) == HSR_OK);
+        CHECK(yp_scan(sh, hf, &o, 0, H, ff) == HSR_OK);
+        for (int i = 0; i < 3 * H; i++) {
+            CHECK(yp_cmdlist_equal(&ff->line[i], &fr->line[i]));
+            int y = i % H;
+            if ((y < y0 || y >= y1) && !yp_cmdlist_equal(&prev[i], &ff->line[i])) changed_outside++;
+        }
+        yp_frame_free(ff); hsr_destroy(hf);
+    }
+    CHECK(changed_outside == 0);
+    CHECK(full_damage == 1);      /* only the light frame re-scans everything */
+    for (int i = 0; i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
+    free(prev);
+    yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); yp_anim_free(an);
+}
+
 void suite_yp(void)
 {
     RUN(test_yp_span_of_one_pixel);
@@ -373,4 +441,5 @@ void suite_yp(void)
     RUN(test_yp_transparent_layer_mixes_with_behind);
     RUN(test_yp_scene_exceeding_intensity_is_rejected);
     RUN(test_yp_de48_stream_layout);
+    RUN(test_yp_anim_incremental_equals_full_rebuild);
 }
