@@ -122,3 +122,22 @@ def test_scene_that_can_exceed_full_intensity_is_rejected(yproc, tmp_path):
     r = yc.run("scan", s, "-o", tmp_path / "o", ok=False)
     assert r.returncode == 1
     assert "s.scene:" in r.stderr and "can exceed intensity 1" in r.stderr
+
+
+def test_background_image_uses_eval0(yproc, tmp_path):
+    """`background image sky.ppm`: uncovered pixels are Eval0 runs of the
+    picture, covered ones accumulate picture + patterns; still bit-exact"""
+    s = yc.small_scene(yc.SCENES / "cad/cad_sky.scene", tmp_path / "s.scene", W, H)
+    text = s.read_text().replace("background image sky.ppm",
+                                 f"background image {yc.SCENES / 'cad' / 'sky.ppm'}")
+    s.write_text(text)
+    out, st = scan(tmp_path, s, "--capacity", "100000", "--cmd")
+    assert st["totals"]["evals"]["eval0"] > 0
+    exp, ideal = check_golden(out, st, 0.5 + 4 * TOL + 0.05)
+    # a corner pixel nobody covers shows the picture (top left: sky, 8-bit -> 12-bit)
+    data = (yc.SCENES / "cad" / "sky.ppm").read_bytes().split(b"\n", 3)
+    w0, h0 = map(int, data[1].split())
+    sky = np.frombuffer(data[3], dtype=np.uint8).reshape(h0, w0, 3)
+    for c in range(3):
+        assert exp[c, 0, 0] == round(int(sky[0, 0, c]) * 4095 / 255)
+    assert "Eval0 (0, " in (out / "r.cmd").read_text()

@@ -17,7 +17,14 @@ struct yp_shader {
     int nl;
     double L[HSR_MAX_LIGHTS][3], Lrgb[HSR_MAX_LIGHTS][3];
     double bg[3];        /* pixel units */
+    uint16_t *img;       /* background image, 12-bit, [3][H][W], or NULL */
 };
+
+/* background at pixel (x, y), colour c, pixel units */
+static inline double yp_bg(const yp_shader *s, int c, int x, int y)
+{
+    return s->img ? s->img[((size_t)c * (size_t)s->vw.H + (size_t)y) * (size_t)s->vw.W + (size_t)x] : s->bg[c];
+}
 
 /* Colour of face fi at pixel position (px, py) (pixel coordinates, y
  * down), pixel units: base = ambient + diffuse (+ specular unless Phong

@@ -68,6 +68,7 @@ typedef struct scan {
     double *fb, *fs, *ft, *cov;  /* per column: base, spec (nl), total; coverage */
     unsigned char *use, *use2;
     double *tmp, *tolv;
+    double *covsum;            /* [y1 - y0][W]: coverage of all patterns */
 } scan;
 
 /* Dis over the runs of [a, b) where in[x - off] == 0 */
@@ -119,7 +120,7 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         for (int i = 0; i < 3 * nl; i++) fs[i] = 0;
         for (int j = 0; j < nvis; j++) {
             yp_shade_face(sh, par[j], x + 0.5, y + 0.5, base, spec);
-            for (int c = 0; c < 3; c++) fb[c] += w[j] * (base[c] - sh->bg[c]);
+            for (int c = 0; c < 3; c++) fb[c] += w[j] * (base[c] - yp_bg(sh, c, x, y));
             for (int i = 0; i < 3 * nl; i++) fs[i] += w[j] * spec[i];
         }
         for (int c = 0; c < 3; c++) {
@@ -128,6 +129,7 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             s->ft[3 * x + c] = t;
             s->fr->ideal[((size_t)c * s->H + y) * s->W + x] += cov[x - x0] * t;
         }
+        s->covsum[(size_t)(y - s->y0) * s->W + x] += cov[x - x0];
     }
     line_entries *le = &s->le[3 * (y - s->y0)];
     int cf = -1, cl = -1;
@@ -204,9 +206,9 @@ static int ent_area_cmp(const void *pa, const void *pb)
     return a->area < b->area ? -1 : a->area > b->area;
 }
 
-static int line_cost(entry **e, int n, int *spec)
+static int line_cost(entry **e, int n, int *spec, int base)
 {
-    int t = 3, sp = 0;
+    int t = base, sp = 0;
     for (int i = 0; i < n; i++) {
         t += e[i]->cost[e[i]->lev];
         if (e[i]->lev == 3 && e[i]->spec_cost) sp = 1;
@@ -224,23 +226,56 @@ static hsr_status append(yp_cmdlist *dst, const yp_cmdlist *src)
     return HSR_OK;
 }
 
+/* Background image (section 7.4.5: Eval0 carries raster images): pixels
+ * no pattern covers get Eval0 runs of equal 12-bit values (D := I and
+ * locked, 1 slot per run); under the covered pixels the image + 1/2 is
+ * accumulated as a spline (the patterns add cov * (colour - image)). */
+static hsr_status background_image(scan *s, int y, int c, yp_cmdlist *out)
+{
+    const double *cs = &s->covsum[(size_t)(y - s->y0) * s->W];
+    hsr_status st = HSR_OK;
+    int first = -1, last = -1;
+    for (int x = 0; x < s->W && st == HSR_OK;) {
+        if (cs[x] > 0) { if (first < 0) first = x; last = x; x++; continue; }
+        int v = (int)lround(yp_bg(s->sh, c, x, y)), a = x;
+        while (x < s->W && cs[x] <= 0 && (int)lround(yp_bg(s->sh, c, x, y)) == v) x++;
+        yp_cmd e0 = {YP_EVAL0, 0, (uint16_t)a, (uint16_t)(x - a), {v, 0, 0}};
+        st = yp_cmdlist_push(out, e0);
+    }
+    if (first < 0 || st != HSR_OK) return st;
+    int n = last + 1 - first;
+    double *f = s->tmp;
+    unsigned char *use = s->use2;
+    for (int x = first; x <= last; x++) { use[x - first] = cs[x] > 0; f[x - first] = yp_bg(s->sh, c, x, y) + 0.5; }
+    st = push_dis(out, use, first, last + 1, first);
+    if (st == HSR_OK && yp_fit(f, use, NULL, n, first, 2, 0.25, 0, out) < 0) st = HSR_ELIMIT;
+    return st;
+}
+
 /* degrade and emit line y, colour c */
 static hsr_status finish_line(scan *s, int y, int c)
 {
     line_entries *L = &s->le[3 * (y - s->y0) + c];
     yp_line_stats *ls = &s->fr->st[y];
     int n = L->n, sp;
+    /* the background term first: its slots count against the line */
+    yp_cmdlist bgl = {0};
+    hsr_status st0;
+    if (!s->sh->img) {
+        yp_cmd bg = {YP_EVAL, 0, 0, (uint16_t)s->W, {q24(s->sh->bg[c] + 0.5), 0, 0}};
+        st0 = yp_cmdlist_push(&bgl, bg);
+    } else st0 = background_image(s, y, c, &bgl);
     entry **ord = malloc(sizeof(entry *) * (size_t)(n + 1));
-    if (!ord) return HSR_ENOMEM;
+    if (!ord || st0 != HSR_OK) { free(ord); yp_cmdlist_free(&bgl); return st0 != HSR_OK ? st0 : HSR_ENOMEM; }
     if (n) memcpy(ord, L->e, sizeof(entry *) * (size_t)n);
     qsort(ord, (size_t)n, sizeof(entry *), ent_area_cmp);
     /* section 7.5: lower the colour function of the least visible
      * patterns first, Eval3 -> Eval2 for all, then Eval2 -> Eval1 */
-    for (int lev = 3; lev >= 2 && line_cost(L->e, n, NULL) > s->o->capacity; lev--)
-        for (int i = 0; i < n && line_cost(L->e, n, NULL) > s->o->capacity; i++)
+    for (int lev = 3; lev >= 2 && line_cost(L->e, n, NULL, bgl.slots) > s->o->capacity; lev--)
+        for (int i = 0; i < n && line_cost(L->e, n, NULL, bgl.slots) > s->o->capacity; i++)
             if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) ord[i]->lev = lev - 1;
     free(ord);
-    int cost = line_cost(L->e, n, &sp);
+    int cost = line_cost(L->e, n, &sp, bgl.slots);
     ls->degraded[c] = 0;
     for (int i = 0; i < n; i++) if (L->e[i]->lev < L->e[i]->maxlev) ls->degraded[c]++;
     yp_cmdlist *out = &s->fr->line[c * s->H + y];
@@ -262,12 +297,12 @@ static hsr_status finish_line(scan *s, int y, int c)
             if (out->slots <= s->o->capacity) break;
         }
         ls->merged[c] = 1;
+        yp_cmdlist_free(&bgl);
         ls->degraded[c] = n;
         ls->overflow[c] = out->slots > s->o->capacity;
         goto stats;
     }
-    yp_cmd bg = {YP_EVAL, 0, 0, (uint16_t)s->W, {q24(s->sh->bg[c] + 0.5), 0, 0}};
-    st = yp_cmdlist_push(out, bg);
+    st = append(out, &bgl);
     for (int i = 0; i < n && st == HSR_OK; i++)
         st = append(out, &L->e[i]->lv[L->e[i]->lev]);
     if (sp && st == HSR_OK) {
@@ -277,6 +312,7 @@ static hsr_status finish_line(scan *s, int y, int c)
             if (L->e[i]->lev == 3) st = append(out, &L->e[i]->spec);
     }
 stats:
+    yp_cmdlist_free(&bgl);
     ls->cmds[c] = out->n; ls->slots[c] = out->slots;
     if (c == 0) {
         ls->patterns = n; ls->partial = 0;
@@ -310,7 +346,7 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     if (y0 < 0) y0 = 0;
     if (y1 > fr->height) y1 = fr->height;
     if (y0 >= y1) return HSR_OK;
-    scan s = {sh, o, fr, fr->width, fr->height, y0, y1, sh->nl, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+    scan s = {sh, o, fr, fr->width, fr->height, y0, y1, sh->nl, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     const int W = s.W;
     const double U = HSR_SUBPIXEL;
     hsr_status st = HSR_OK;
@@ -322,13 +358,14 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     s.ft = malloc(sizeof(double) * 3 * (size_t)W);
     s.tmp = malloc(sizeof(double) * (size_t)W);
     s.tolv = malloc(sizeof(double) * (size_t)W);
+    s.covsum = calloc((size_t)(y1 - y0) * (size_t)W, sizeof(double));
     s.use = malloc((size_t)W + 1); s.use2 = malloc(2 * (size_t)W + 2);
     double *acc = NULL;
     size_t acccap = 0;
-    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.tmp || !s.tolv || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
+    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.tmp || !s.tolv || !s.covsum || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
     for (int y = y0; y < y1; y++)
         for (int c = 0; c < 3; c++)
-            for (int x = 0; x < W; x++) fr->ideal[((size_t)c * s.H + y) * W + x] = sh->bg[c];
+            for (int x = 0; x < W; x++) fr->ideal[((size_t)c * s.H + y) * W + x] = yp_bg(sh, c, x, y);
     for (int sl = 0; sl < nslots; sl++) {
         const int *par; int nvis;
         if (hsr_llr_get(h, sl, NULL, &par, &nvis, NULL)) { keys[nk].slot = sl; keys[nk].par = par; keys[nk].nvis = nvis; nk++; }
@@ -413,6 +450,6 @@ done:
             free(s.le[i].e);
         }
     }
-    free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.use); free(s.use2);
+    free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
     return st;
 }

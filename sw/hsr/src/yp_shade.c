@@ -8,6 +8,8 @@
 #include <string.h>
 #include "yp_internal.h"
 
+static hsr_status read_ppm(const char *path, int W, int H, uint16_t **out, char *err, size_t errlen);
+
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static int unit3(double *a)
 {
@@ -231,13 +233,50 @@ hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out, 
     s->gour = malloc(sizeof(double) * 15 * (size_t)(sc->nf + 1));
     if (!s->vn || !s->fn || !s->flat || !s->gour) { yp_shader_free(s); return HSR_ENOMEM; }
     hsr_status st = yp_shader_update(s, sc);
+    if (st == HSR_OK && sc->bg_image[0]) st = read_ppm(sc->bg_image, sc->width, sc->height, &s->img, err, errlen);
     if (st != HSR_OK) { yp_shader_free(s); return st; }
     *out = s;
+    return HSR_OK;
+}
+
+/* binary PPM (P6, maxval 1..65535) -> 12-bit [3][H][W], scaled to the
+ * screen by nearest neighbour; simple enough to read without a library. */
+static hsr_status read_ppm(const char *path, int W, int H, uint16_t **out, char *err, size_t errlen)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) { if (err) snprintf(err, errlen, "%s: cannot read background image", path); return HSR_EIO; }
+    int w, h, maxv;
+    char m[3] = {0};
+    if (fscanf(f, "%2s %d %d %d", m, &w, &h, &maxv) != 4 || strcmp(m, "P6") || maxv < 1 || maxv > 65535 || fgetc(f) == EOF) {
+        fclose(f);
+        if (err) snprintf(err, errlen, "%s: not a binary PPM (P6)", path);
+        return HSR_EPARSE;
+    }
+    /* any size: scaled to the screen by nearest neighbour */
+    int bytes = maxv > 255 ? 2 : 1;
+    uint16_t *src = malloc(sizeof(uint16_t) * 3 * (size_t)w * (size_t)h);
+    uint16_t *img = malloc(sizeof(uint16_t) * 3 * (size_t)W * (size_t)H);
+    if (!img || !src) { free(img); free(src); fclose(f); return HSR_ENOMEM; }
+    for (size_t i = 0; i < 3 * (size_t)w * (size_t)h; i++) {
+        int v = fgetc(f);
+        if (bytes == 2 && v >= 0) { int lo = fgetc(f); v = lo < 0 ? -1 : (v << 8) | lo; }
+        if (v < 0) { free(img); free(src); fclose(f); if (err) snprintf(err, errlen, "%s: truncated", path); return HSR_EPARSE; }
+        src[i] = (uint16_t)lround((double)v * 4095.0 / maxv);
+    }
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            size_t sx = (size_t)x * (size_t)w / (size_t)W, sy = (size_t)y * (size_t)h / (size_t)H;
+            for (int c = 0; c < 3; c++) img[((size_t)c * H + y) * W + x] = src[3 * (sy * (size_t)w + sx) + (size_t)c];
+        }
+    free(src);
+    fclose(f);
+    *out = img;
     return HSR_OK;
 }
 
 void yp_shader_free(yp_shader *s)
 {
     if (!s) return;
+    free(s->img);
     free(s->vn); free(s->fn); free(s->flat); free(s->gour); free(s);
 }

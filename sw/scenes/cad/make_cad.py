@@ -4,8 +4,8 @@ transparent, interpenetrating parts.  Standard library only; triangles only.
 
     python3 sw/scenes/cad/make_cad.py [-o DIR]
 
-writes DIR/{plate,column,bracket,ball,glass,slider,pane}.obj; cad.scene and
-../anim/anim.scene refer to them.
+writes DIR/{plate,column,bracket,ball,glass,slider,pane}.obj and sky.ppm;
+cad.scene, cad_sky.scene and ../anim/anim.scene refer to them.
 """
 from __future__ import annotations
 
@@ -91,6 +91,22 @@ def write(path: Path, verts, tris, comment, groups=None):
     path.write_text("\n".join(lines) + "\n")
 
 
+def write_sky(path: Path, w: int = 80, h: int = 60) -> None:
+    """background picture for cad_sky.scene: a sky gradient with a sun disc and
+    banded hills (binary PPM, 8 bit; yproc scales it to the screen)"""
+    px = bytearray()
+    for y in range(h):
+        for x in range(w):
+            t = y / (h - 1)
+            r, g, b = 0.55 + 0.35 * t, 0.7 + 0.25 * t, 0.95
+            if (x - 62) ** 2 + (y - 12) ** 2 < 30:
+                r, g, b = 1.0, 0.95, 0.7
+            if y > 40 + 4 * math.sin(x / 7.0):
+                r, g, b = 0.35, 0.55 - 0.004 * (y - 40), 0.3
+            px += bytes(int(round(255 * v)) for v in (r, g, b))
+    path.write_bytes(b"P6\n%d %d\n255\n" % (w, h) + bytes(px))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("-o", default=str(Path(__file__).parent))
@@ -104,6 +120,7 @@ def main() -> None:
     write(out / "glass.obj", *box(0.3, 0.7, 1.3, 3.0, 1.4, 0.04), "glass panel in front (transparent)")
     # for sw/scenes/anim: a small block to drag and a two-triangle pane
     write(out / "slider.obj", *box(1.2, 0.2, -0.6, 0.5, 0.4, 0.5), "slider block (flat), dragged in the animation")
+    write_sky(out / "sky.ppm")
     write(out / "pane.obj", [(-1.9, 0.0, -1.2), (-0.2, 0.0, -1.2), (-0.2, 1.3, -1.2), (-1.9, 1.3, -1.2)],
           [(0, 1, 2), (0, 2, 3)], "glass pane at the back (transparent)")
 
