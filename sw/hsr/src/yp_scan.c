@@ -252,6 +252,20 @@ static hsr_status background_image(scan *s, int y, int c, yp_cmdlist *out)
     return st;
 }
 
+/* 1 if a pixel of the line would differ from its exact value by more
+ * than half the range (the 12-bit pixel wrapped) */
+static int wraps(scan *s, const yp_cmdlist *l, int y, int c)
+{
+    uint16_t *pix = malloc(sizeof(uint16_t) * (size_t)s->W);
+    if (!pix) return 0;
+    yp_simulate_line(l, s->W, pix);
+    const double *id = &s->fr->ideal[((size_t)c * s->H + y) * s->W];
+    int bad = 0;
+    for (int x = 0; x < s->W && !bad; x++) bad = fabs(pix[x] - id[x]) > 2048;
+    free(pix);
+    return bad;
+}
+
 /* degrade and emit line y, colour c */
 static hsr_status finish_line(scan *s, int y, int c)
 {
@@ -282,7 +296,23 @@ static hsr_status finish_line(scan *s, int y, int c)
     yp_cmdlist_free(out);
     hsr_status st = HSR_OK;
     ls->merged[c] = ls->overflow[c] = 0;
-    if (cost > s->o->capacity) {
+    if (cost <= s->o->capacity) {
+        st = append(out, &bgl);
+        for (int i = 0; i < n && st == HSR_OK; i++)
+            st = append(out, &L->e[i]->lv[L->e[i]->lev]);
+        if (sp && st == HSR_OK) {
+            yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}};
+            st = yp_cmdlist_push(out, am);
+            for (int i = 0; i < n && st == HSR_OK; i++)
+                if (L->e[i]->lev == 3) st = append(out, &L->e[i]->spec);
+        }
+        /* The array wraps (docs/isa.md section 1): a pixel whose exact value
+         * is within the fit tolerance of 0 or 4096 could come out as its
+         * opposite.  Check the line with the array model; if it happens, the
+         * line takes the merged form below, whose targets keep clear of both. */
+        if (st == HSR_OK && wraps(s, out, y, c)) cost = s->o->capacity + 1;
+    }
+    if (st == HSR_OK && cost > s->o->capacity) {
         /* Even Eval1 for every pattern does not fit: the last resort
          * before dropping anything is one spline for the whole line
          * through the exact target values, with a tolerance raised until
@@ -290,28 +320,16 @@ static hsr_status finish_line(scan *s, int y, int c)
         double *f = s->tmp;
         unsigned char *use = s->use2;
         const double *id = &s->fr->ideal[((size_t)c * s->H + y) * s->W];
-        for (int x = 0; x < s->W; x++) { f[x] = id[x] + 0.5; use[x] = 1; }
         for (double tol = 4 * s->o->tol; tol < 8192; tol *= 2) {
+            for (int x = 0; x < s->W; x++) { f[x] = fmin(fmax(id[x] + 0.5, 0.5 + tol), 4095.5 - tol); use[x] = 1; }
             yp_cmdlist_free(out);
             if (yp_fit(f, use, NULL, s->W, 0, 2, tol, 0, out) < 0) { st = HSR_ELIMIT; break; }
             if (out->slots <= s->o->capacity) break;
         }
         ls->merged[c] = 1;
-        yp_cmdlist_free(&bgl);
         ls->degraded[c] = n;
         ls->overflow[c] = out->slots > s->o->capacity;
-        goto stats;
     }
-    st = append(out, &bgl);
-    for (int i = 0; i < n && st == HSR_OK; i++)
-        st = append(out, &L->e[i]->lv[L->e[i]->lev]);
-    if (sp && st == HSR_OK) {
-        yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}};
-        st = yp_cmdlist_push(out, am);
-        for (int i = 0; i < n && st == HSR_OK; i++)
-            if (L->e[i]->lev == 3) st = append(out, &L->e[i]->spec);
-    }
-stats:
     yp_cmdlist_free(&bgl);
     ls->cmds[c] = out->n; ls->slots[c] = out->slots;
     if (c == 0) {

@@ -427,6 +427,38 @@ static void test_yp_anim_incremental_equals_full_rebuild(void)
     yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); yp_anim_free(an);
 }
 
+/* values at the ends of the range never wrap: white on white and near
+ * black on black, with edges and ramps that need fitting */
+static void test_yp_no_wrap_at_full_intensity_and_black(void)
+{
+    for (int white = 0; white <= 1; white++) {
+        typ t;
+        CHECK(setup(&t, 40, 6, 2, NULL, YP_GOURAUD, white ? 1.0 : 0.0));
+        for (int i = 0; i < 2; i++) {
+            double *g = &t.sh->gour[15 * i];
+            for (int c = 0; c < 3; c++) {
+                g[3 * c] = white ? 37.3 : -0.71; g[3 * c + 1] = 1.3; g[3 * c + 2] = white ? 3000 : 20;
+                g[9 + 2 * c] = white ? 3000 : 0; g[10 + 2 * c] = white ? 4095 : 20;
+            }
+        }
+        double tri[6] = {1.3, 0.2, 38.6, 0.7, 20.2, 5.9};
+        add_poly(&t, tri, 3, 1, 1);
+        add_rect(&t, 0, 0, 40, 6, 2);
+        t.o.tol = 40;
+        CHECK(yp_scan(t.sh, t.h, &t.o, 0, 6, t.fr) == HSR_OK);
+        for (int y = 0; y < 6; y++)
+            for (int c = 0; c < 3; c++) {
+                uint16_t pix[40];
+                pixels(&t, y, c, pix);
+                for (int x = 0; x < 40; x++) {
+                    double id = t.fr->ideal[((size_t)c * 6 + y) * 40 + x];
+                    CHECK(fabs(pix[x] - id) <= 3 * 40 + 1);
+                }
+            }
+        teardown(&t);
+    }
+}
+
 void suite_yp(void)
 {
     RUN(test_yp_span_of_one_pixel);
@@ -442,4 +474,5 @@ void suite_yp(void)
     RUN(test_yp_scene_exceeding_intensity_is_rejected);
     RUN(test_yp_de48_stream_layout);
     RUN(test_yp_anim_incremental_equals_full_rebuild);
+    RUN(test_yp_no_wrap_at_full_intensity_and_black);
 }
