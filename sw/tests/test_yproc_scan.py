@@ -141,3 +141,6 @@ def test_background_image_uses_eval0(yproc, tmp_path):
     for c in range(3):
         assert exp[c, 0, 0] == round(int(sky[0, 0, c]) * 4095 / 255)
     assert "Eval0 (0, " in (out / "r.cmd").read_text()
+    for name in "rgb":     # Eval0 in the text form reads back to the same stream
+        cmds = asm.parse_text((out / f"{name}.cmd").read_text(), f"{name}.cmd")
+        assert cmds == yc.stream_commands(out / f"{name}.de48")
