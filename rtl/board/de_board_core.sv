@@ -32,7 +32,7 @@ module de_board_core #(
 ) (
   input  logic            clk_i,
   input  logic            rst_i,
-  input  logic [1:0]      mode_i,       // video mode (docs/display-controller.md §3), sampled in reset
+  input  logic [1:0]      mode_i,       // video mode (display-controller.md §3), in reset
   input  logic            uart_rx_i,
   output logic            uart_tx_o,
   output logic [2:0][9:0] tmds_o,       // [0] blue + sync, [1] green, [2] red; bit 0 first
