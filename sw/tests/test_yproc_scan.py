@@ -144,3 +144,17 @@ def test_background_image_uses_eval0(yproc, tmp_path):
     for name in "rgb":     # Eval0 in the text form reads back to the same stream
         cmds = asm.parse_text((out / f"{name}.cmd").read_text(), f"{name}.cmd")
         assert cmds == yc.stream_commands(out / f"{name}.de48")
+
+
+def test_no_pixel_wraps_on_the_teapot_at_640x480(yproc, tmp_path):
+    """teapot_phong at full size (blue background 1.0): degraded and merged
+    lines near full intensity must not wrap to 0 (the array does not
+    saturate); yproc's own model of the streams (expect.ppm, equal to the
+    golden model's frame by the tests above) stays near the exact frame"""
+    out, st = scan(tmp_path, yc.SCENES / "teapot/teapot_phong.scene", "--mode", "640x480")
+    assert st["totals"]["lines_degraded"] > 0 and st["totals"]["lines_overflow"] == 0
+    exp = yc.read_ppm16(out / "expect.ppm")
+    ideal = yc.read_ideal(out / "ideal.f64", 480, 640)
+    err = np.abs(exp - ideal)
+    assert err.max() < 64, err.max()
+    assert np.mean(err) < 0.5
