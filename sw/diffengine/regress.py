@@ -349,8 +349,14 @@ def heatmap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 # ---- running one case ------------------------------------------------------------------
 
 
+# One Verilator thread per case: the runner already runs -j cases at once, and a
+# multi-threaded model spin-waits badly when the cores are shared (measured: a 72-chip
+# 20k-command case ran > 10 min with 2 threads on a loaded 2-core machine).
+THREADS = 1
+
+
 def _exe(chips: int, bug: bool) -> Path:
-    return harness.build(chips, bug)
+    return harness.build(chips, bug, threads=THREADS)
 
 
 def _bug_model_cost(commands) -> int:
@@ -480,7 +486,7 @@ def trace_compare(case: Case, commands, line: int, col: int) -> str:
 def write_waves(case: Case, commands, workdir: Path, line: int, col: int) -> list[str]:
     """A windowed FST of the bad line and its GTKWave save file (the trace build's
     `--fst FILE --line L --col Q`), next to the report."""
-    exe = harness.build(case.chips, case.bug, trace=True)
+    exe = harness.build(case.chips, case.bug, threads=THREADS, trace=True)
     stem = f"line{line}_col{col}"
     src = workdir / "prefix.de48"
     src.write_bytes(binfmt.encode_de48(isa.serialise(_prefix(commands, line))))
