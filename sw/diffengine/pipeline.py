@@ -64,6 +64,14 @@ class Progress:
             print("\r" + " " * 79 + "\r", end="", file=sys.stderr, flush=True)
 
 
+def _cpu() -> float:
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    c = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime + c.ru_utime + c.ru_stime
+
+
 def screen_of(scene: Path) -> tuple[int, int]:
     sc = reference.Scene()
     for line in Path(scene).read_text().splitlines():
@@ -199,11 +207,17 @@ def run(scene, outdir, chips: int = 72, threads: int = 1, rtl: bool = True,
                  "mode": mode, "test_geometry": list(test) if mode == 3 else None,
                  "threads": threads, "anti_aliasing": aa, "shading": shading or "scene",
                  "stages": {}}
-    stages = rep["stages"]
+    stages, cpu = rep["stages"], rep.setdefault("stages_cpu", {})
+    clock = [_cpu()]
 
     def stage(name, secs):
+        # wall seconds, and CPU seconds of this process and its children since the last
+        # stage (on a shared machine the CPU figure is the one that compares)
+        now = _cpu()
         stages[name] = round(secs, 3)
-        log(f"  {name:<28} {secs:8.2f} s")
+        cpu[name] = round(now - clock[0], 3)
+        clock[0] = now
+        log(f"  {name:<28} {secs:8.2f} s  (cpu {cpu[name]:7.2f} s)")
 
     log(f"demo: {rep['scene']} at {W}x{H}, {chips} chips x 3 colours"
         + ("" if rtl else " (model only, --no-rtl)"))
@@ -236,9 +250,9 @@ def run(scene, outdir, chips: int = 72, threads: int = 1, rtl: bool = True,
         pb.close()
         stage("RTL display_controller", time.monotonic() - t)
         rtl_frame = frames[-1]
-        rep["rtl"] = {k: st[k] for k in ("cycles", "seconds", "cycles_per_second", "frames",
-                                         "h_total", "v_total", "sync", "align_err",
-                                         "pix_collision", "threads")}
+        rep["rtl"] = {k: st.get(k) for k in (
+            "cycles", "seconds", "cycles_per_second", "cpu_seconds", "cycles_per_cpu_second",
+            "frames", "h_total", "v_total", "sync", "align_err", "pix_collision", "threads")}
         rep["load_monitor"] = {c: {k: v for k, v in m.items() if k != "line_issued"}
                                for c, m in st["load_monitor"].items()}
         rep["commands_per_line"] = {c: m["line_issued"] for c, m in st["load_monitor"].items()}
