@@ -22,14 +22,19 @@ REPO = Path(__file__).resolve().parents[2]
 EXIT_BREAK = 3  # the harness stopped at a breakpoint
 
 # Verilator threads per chip count where they were measured to help (docs/performance.md,
-# "Verilated array speed"): on the 2-core build machines a second thread pays only for the
-# full 72-chip array; below that the threads' synchronisation costs more than they win.
-THREADS_FROM_CHIPS = 72
+# "Verilated array speed"). On the 2-core build machines, shared by several jobs, no
+# array size gained from a second thread: Verilator's threads spin-wait for each other
+# every cycle, and with more runnable threads than cores 1, 8 and 72 chips ran 20-270x
+# slower with 2 threads. So the default is 1 thread everywhere; `threads=` / THREADS=
+# still build and run a threaded model for machines with idle cores.
+THREADS_FROM_CHIPS: int | None = None
 
 
 def default_threads(chips: int) -> int:
     """Verilator threads to use for `chips` chips when the caller does not say."""
-    return 2 if chips >= THREADS_FROM_CHIPS and (os.cpu_count() or 1) >= 2 else 1
+    if THREADS_FROM_CHIPS is not None and chips >= THREADS_FROM_CHIPS:
+        return 2
+    return 1
 
 
 def tag(chips: int, carry_bug: bool = False, threads: int = 1, trace: bool = False) -> str:
