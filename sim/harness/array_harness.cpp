@@ -675,7 +675,11 @@ int main(int argc, char** argv) {
           std::printf("\n%s\n", kCsvHeader);
           for (size_t k = 0; k < show.size(); ++k)
             std::printf("%s\n", state_of(cycle, probes[k]).c_str());
-          if (fst) fst->close();
+          if (fst) {
+            fst->close();
+            if (!write_gtkw(o.fst, wave_pes, 10 * w_from, err))
+              std::fprintf(stderr, "%s\n", err.c_str());
+          }
           if (csv && csv != stdout) std::fclose(csv);
           std::fflush(stdout);
           top->final();

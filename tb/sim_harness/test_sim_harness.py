@@ -38,8 +38,11 @@ def seed():
 
 @pytest.fixture(scope="module")
 def stream(seed):
-    """A few random lines for an 18-PE array (spans cross the chip boundary)."""
-    cmds = structural.random_commands(np.random.default_rng(seed), N_PE, 70, refresh_every=15)
+    """At least four random lines for an 18-PE array (spans cross the chip boundary):
+    four chunks, each ending with a Refresh."""
+    rng = np.random.default_rng(seed)
+    cmds = [c for _ in range(4)
+            for c in structural.random_commands(rng, N_PE, 18, refresh_every=15)]
     return cmds, isa.serialise(cmds)
 
 
@@ -90,7 +93,7 @@ def test_fst_window_is_small_and_exact(stream, tmp_path):
     src = tmp_path / "in.de48"
     src.write_bytes(binfmt.encode_de48(slots))
     t = trace.Timing.of(slots, CHIPS)
-    assert len(t.refresh_at) >= 3, "the stream should have a few lines"
+    assert len(t.refresh_at) >= 4, "the stream should have a few lines"
     lo, hi = t.line_window(1)
     res = run(exe, src, tmp_path / "a.depx", "--fst", tmp_path / "line.fst", "--line", 1,
               "--col", 10)
@@ -154,9 +157,12 @@ def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
     c, rows = stopped(run(exe, src, tmp_path / "o", "--break-cycle", 57, "--trace-pes",
                           "8-10", rc=3))
     assert c == 57 and rows == [by_key[("57", str(p))] for p in (8, 9, 10)]
-    # At a scanline: its first instruction is on ident_i.
-    c, _ = stopped(run(exe, src, tmp_path / "o", "--break-line", 2, rc=3))
+    # At a scanline: its first instruction is on ident_i. A dump stops there too, with
+    # its save file.
+    c, _ = stopped(run(exe, src, tmp_path / "o", "--break-line", 2, "--fst",
+                       tmp_path / "b.fst", rc=3))
     assert c == t.refresh_at[1] + 1
+    assert (tmp_path / "b.fst").stat().st_size > 0 and (tmp_path / "b.gtkw").exists()
     # When PE 10 (chip 1) receives the first ACC: slot k reaches PE p in cycle k + p + chip.
     k = next(i for i, (ident, _) in enumerate(t.seq) if ident == isa.ACC)
     res = run(exe, src, tmp_path / "o", "--break-pe", 10, "--break-op", "acc", rc=3)
