@@ -104,91 +104,138 @@ def cocotb_rate(chips: int, n_commands: int, seed: int) -> float:
 
 
 def main(argv=None) -> int:
+    import json
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--threads", type=int, default=2, help="threaded builds to compare")
-    ap.add_argument("--no-build-times", action="store_true")
+    ap.add_argument("--parts", default="builds,rates,frame,models,cocotb",
+                    help="what to measure this time (results merge into --json)")
+    ap.add_argument("--thread-counts", default=None,
+                    help="thread counts for the rates part (default: 1,<--threads>)")
+    ap.add_argument("--short", action="store_true",
+                    help="short runs (loaded machine): 1/8 chips ~30-60k cycles, 72 chips the "
+                    "first 12 lines of the frame; the frame part runs 1/5 of the frame and "
+                    "scales by 5")
+    ap.add_argument("--json", default=str(ROOT / "sim" / "out" / "bench_array.json"))
     ap.add_argument("--write", action="store_true")
     a = ap.parse_args(argv)
-    res: dict = {"threads": a.threads, "cpus": os.cpu_count()}
+    parts = set(a.parts.split(","))
+    jpath = Path(a.json)
+    res: dict = json.loads(jpath.read_text()) if jpath.exists() else {}
+    res.update({"threads": a.threads, "cpus": os.cpu_count()})
+    if a.short and "rates" in parts:
+        res["short"] = True
+    rates = {tuple(map(int, k.split(","))): v for k, v in res.get("rates", {}).items()}
 
-    if not a.no_build_times:
+    def save():
+        res["rates"] = {f"{c},{t}": v for (c, t), v in rates.items()}
+        jpath.parent.mkdir(parents=True, exist_ok=True)
+        jpath.write_text(json.dumps(res, indent=1))
+
+    if "builds" in parts:
         for chips in (8, 72):
             res[f"build{chips}"] = b = build_times(chips)
             log(f"build {chips:2d} chips: cold {b['cold']:.1f} s, no-op {b['noop']:.2f} s, "
                 f"warm ccache {b['ccache']:.1f} s")
+            save()
 
-    # Cycles/s: random streams for 1 and 8 chips (repeated for a long enough run), the
-    # display frame for 72 chips.
     tmp = Path(tempfile.mkdtemp())
     frame_cmds = random_frame(np.random.default_rng(a.seed), mixed=True)
-    (tmp / "frame.de48").write_bytes(binfmt.encode_de48(frame_slots(frame_cmds)))
+    fslots = frame_slots(frame_cmds)
+    (tmp / "frame.de48").write_bytes(binfmt.encode_de48(fslots))
+    (tmp / "part.de48").write_bytes(binfmt.encode_de48(fslots[:LINE_SLOTS * LINES // 5]))
+    (tmp / "rate.de48").write_bytes(binfmt.encode_de48(fslots[:LINE_SLOTS * 12]))
     for chips in (1, 8):
         cmds = randgen.stream(a.seed, 4000, 9 * chips, (1, 40))
         (tmp / f"r{chips}.de48").write_bytes(binfmt.encode_de48(isa.serialise(cmds)))
-    rates = {}
-    for threads in (1, a.threads):
-        for chips in (1, 8, 72):
-            t = time.perf_counter()
-            exe = harness.build(chips, threads=threads)
-            bt = time.perf_counter() - t
-            if chips == 72:
-                rate, wall = run_exe(exe, tmp / "frame.de48")
-                res[f"frame_t{threads}"] = wall
-            else:
-                rate, wall = run_exe(exe, tmp / f"r{chips}.de48", repeat=40 if chips == 1 else 8)
-            rates[(chips, threads)] = rate
-            log(f"harness {chips:2d} chips, {threads} thread(s): {rate:12,.0f} cycles/s "
-                f"(build/check {bt:.0f} s, run {wall:.1f} s)")
-    res["rates"] = rates
+    if "rates" in parts:
+        counts = [int(t) for t in (a.thread_counts or f"1,{a.threads}").split(",")]
+        for threads in counts:
+            for chips in (1, 8, 72):
+                t = time.perf_counter()
+                exe = harness.build(chips, threads=threads)
+                bt = time.perf_counter() - t
+                if chips == 72:
+                    src = tmp / ("rate.de48" if a.short else "frame.de48")
+                    rate, wall = run_exe(exe, src)
+                    if not a.short:
+                        res[f"frame_t{threads}"] = wall
+                else:
+                    rep = (4 if chips == 1 else 2) if a.short else (40 if chips == 1 else 8)
+                    rate, wall = run_exe(exe, tmp / f"r{chips}.de48", repeat=rep)
+                rates[(chips, threads)] = rate
+                log(f"harness {chips:2d} chips, {threads} thread(s): {rate:12,.0f} cycles/s "
+                    f"(build/check {bt:.0f} s, run {wall:.1f} s{', short' if a.short else ''})")
+                save()
 
-    # Three colours = three arrays: three processes at once (the best thread count each).
-    best_t = 1 if rates[(72, 1)] >= rates[(72, a.threads)] else a.threads
-    exe = harness.build(72, threads=best_t)
-    t = time.perf_counter()
-    procs = [subprocess.Popen([str(exe), str(tmp / "frame.de48"), str(tmp / f"c{i}.depx"),
-                               "--quiet"]) for i in range(3)]
-    for p in procs:
-        if p.wait():
-            raise RuntimeError("harness failed")
-    res["frame3"] = time.perf_counter() - t
-    res["frame3_threads"] = best_t
-    log(f"three colours (3 processes, {best_t} thread(s) each): {res['frame3']:.1f} s")
-    # The same frame (equal pixels) through the Python golden models.
-    t = time.perf_counter()
-    ref = functional.render(frame_cmds, 648)
-    res["functional"] = time.perf_counter() - t
-    got = harness.read_depx(tmp / "c0.depx")
-    res["frame_equal"] = bool(np.array_equal(got[:LINES], ref))
-    lines = isa.split_lines(frame_cmds)[:8]
-    t = time.perf_counter()
-    structural.render([c for ln in lines for c in ln], 648)
-    res["structural"] = (time.perf_counter() - t) / len(lines) * LINES
-    log(f"golden models, same frame: functional {res['functional']:.2f} s, structural "
-        f"{res['structural']:.0f} s (8 lines x 60); RTL frame == functional: "
-        f"{res['frame_equal']}")
+    if "frame" in parts:
+        # Three colours = three arrays: three processes at once (the best thread count).
+        best_t = 1 if rates.get((72, 1), 0) >= rates.get((72, a.threads), 0) else a.threads
+        exe = harness.build(72, threads=best_t)
+        src, scale = (tmp / "part.de48", 5) if a.short else (tmp / "frame.de48", 1)
+        t = time.perf_counter()
+        procs = [subprocess.Popen([str(exe), str(src), str(tmp / f"c{i}.depx"), "--quiet"])
+                 for i in range(3)]
+        for p in procs:
+            if p.wait():
+                raise RuntimeError("harness failed")
+        res["frame3"] = (time.perf_counter() - t) * scale
+        res["frame3_threads"] = best_t
+        res["frame3_scaled"] = scale
+        log(f"three colours (3 processes, {best_t} thread(s) each): {res['frame3']:.1f} s"
+            + (f" (1/{scale} of the frame x {scale})" if scale > 1 else ""))
+        got = harness.read_depx(tmp / "c0.depx")
+        ref = functional.render([c for ln in isa.split_lines(frame_cmds)[:got.shape[0]]
+                                 for c in ln], 648)
+        res["frame_equal"] = bool(np.array_equal(got, ref))
+        res["frame_equal_lines"] = int(got.shape[0])
+        save()
 
-    t = time.perf_counter()
-    res["cocotb"] = cocotb_rate(1, 1000, a.seed)
-    log(f"cocotb 1 chip: {res['cocotb']:,.0f} cycles/s (wall {time.perf_counter() - t:.0f} s)")
+    if "models" in parts:
+        t = time.perf_counter()
+        functional.render(frame_cmds, 648)
+        res["functional"] = time.perf_counter() - t
+        lines = isa.split_lines(frame_cmds)[:8]
+        t = time.perf_counter()
+        structural.render([c for ln in lines for c in ln], 648)
+        res["structural"] = (time.perf_counter() - t) / len(lines) * LINES
+        log(f"golden models, same frame: functional {res['functional']:.2f} s, structural "
+            f"{res['structural']:.0f} s (8 lines x 60)")
+        save()
+
+    if "cocotb" in parts:
+        t = time.perf_counter()
+        res["cocotb"] = cocotb_rate(1, 1000, a.seed)
+        log(f"cocotb 1 chip: {res['cocotb']:,.0f} cycles/s (wall {time.perf_counter() - t:.0f} s)")
+        save()
     shutil.rmtree(tmp, ignore_errors=True)
     if a.write:
-        write_doc(res, not a.no_build_times)
+        write_doc(res, rates, "build72" in res)
     return 0
 
 
-def write_doc(r: dict, with_builds: bool) -> None:
+def write_doc(r: dict, rates: dict, with_builds: bool) -> None:
     import platform
 
     path = ROOT / "docs" / "performance.md"
     text = path.read_text()
     t = r["threads"]
-    rates = r["rates"]
     rows = "\n".join(
         f"| {c} | {9 * c} | {rates[(c, 1)]:,.0f} | {rates[(c, t)]:,.0f} | "
-        f"{rates[(c, t)] / rates[(c, 1)]:.2f}x | {rates[(c, 1)] * 9 * c / 1e6:,.1f} |"
+        f"{rates[(c, t)] / rates[(c, 1)]:.3g}x | {rates[(c, 1)] * 9 * c / 1e6:,.1f} |"
         for c in (1, 8, 72))
     cycles = LINE_SLOTS * TOTAL_LINES
+    short_note = (" (the threaded rates are short runs: 1 chip ~60k cycles, 8 chips ~30k, "
+                  "72 chips the first 12 lines of the frame)" if r.get("short") else "")
+    frame_t = (f"{r[f'frame_t{t}']:.1f}" if f"frame_t{t}" in r else
+               f"{cycles / rates[(72, t)]:,.0f} (cycles / the rate above)")
+    f3_note = (f", 1/{r['frame3_scaled']} of the frame timed, x{r['frame3_scaled']}"
+               if r.get("frame3_scaled", 1) > 1 else "")
+    note = f" ({r['note']})" if r.get("note") else ""
+    passes = r.get("passes", "one run")
+    thr_default = ("`THREADS_FROM_CHIPS = None`" if harness.THREADS_FROM_CHIPS is None
+                   else f"2 from {harness.THREADS_FROM_CHIPS} chips")
     builds = ""
     if with_builds:
         builds = "\n".join(
@@ -208,17 +255,22 @@ ccache (what a `make clean` or a fresh checkout of the same RTL costs).
 
 The C++ harness (`sim/harness/array_harness.cpp`, no Python in the clock loop) on
 `de_array`, Verilator 5.48 `-O3`, g++ `-O2`, {platform.machine()} with {r['cpus']} cores shared
-with other jobs while measuring. 1 and 8 chips: constrained-random streams (`randgen`),
-Refreshes padded to the array width; 72 chips: the display frame below.
+with other jobs while measuring{note}. 1 and 8 chips: constrained-random streams
+(`randgen`), Refreshes padded to the array width; 72 chips: the display frame below. All
+figures come from `scripts/bench_array.py` ({passes}); absolute numbers move with the load,
+the ratios much less.
 
 | chips | PEs | cycles/s, 1 thread | cycles/s, {t} threads | threads speed-up | PE-cycles/s (M), 1 thread |
 |---|---|---|---|---|---|
 {rows}
 
 **Where threads help.** `--threads N` is a separate cached build
-(`sim/build/array_c<N>_b<B>_t<T>_tr<0|1>`). `harness.default_threads()` picks
-{harness.THREADS_FROM_CHIPS}+ chips -> 2 threads, else 1, from this table: a Verilated
-thread needs a few hundred PEs' work per cycle to pay for its per-cycle synchronisation.
+(`sim/build/array_c<N>_b<B>_t<T>_tr<0|1>`), same frames (tested). On this machine it helped
+nowhere: Verilator's threads meet at a barrier every cycle and spin while they wait, so
+with more runnable threads than idle cores (two cores, shared with other jobs) every
+cycle waits for a descheduled thread{short_note}. `harness.default_threads()` therefore
+returns 1 for every array size ({thr_default}); pass `threads=` / `THREADS=` /
+`--threads` on a machine with idle cores and measure again with this script.
 
 **A 640x480 frame.** The mixed random frame of the golden-model bench
 (`scripts/bench_model.py`, ~100 commands per line), each line padded to the 800-slot line
@@ -227,21 +279,24 @@ period, 45 blank lines: {cycles:,} cycles per colour (+ drain).
 | what | seconds per frame |
 |---|---|
 | RTL, one colour, 72 chips, 1 thread (whole process) | {r['frame_t1']:.1f} |
-| RTL, one colour, 72 chips, {t} threads | {r[f'frame_t{t}']:.1f} |
-| RTL, three colours = three arrays as three processes at once ({r['frame3_threads']} thread(s) each) | {r['frame3']:.1f} |
+| RTL, one colour, 72 chips, {t} threads | {frame_t} |
+| RTL, three colours = three arrays as three processes at once ({r['frame3_threads']} thread(s) each){f3_note} | {r['frame3']:.1f} |
 | Python functional golden model, the same frame, one colour | {r['functional']:.2f} |
 | Python structural (cycle-level) model, one colour (8 lines, x60) | {r['structural']:.0f} |
 
-The RTL frame equals the functional model's pixel for pixel: {r['frame_equal']}.
+The RTL frame equals the functional model's pixel for pixel ({r.get('frame_equal_lines', 480)} lines compared): {r['frame_equal']}.
 {builds}
 cocotb 2.1 driving the same kind of stream into the same 1-chip build
-(`tb/bench_cocotb/bench_cocotb.py`, driver only), measured in the same run:
+(`tb/bench_cocotb/bench_cocotb.py`, driver only):
 **{r['cocotb']:,.0f} cycles/s, {rates[(1, 1)] / r['cocotb']:,.0f}x slower** than the C++ harness,
 which is why the scoreboards and `make sim` run through the harness and cocotb keeps
 the cycle-level checks on small arrays.
 
-Reproduce: `.venv/bin/python scripts/bench_array.py --write` (about 20 minutes on two
-busy cores; `--no-build-times` skips the cold builds).
+Reproduce: `source .venv/env.sh; .venv/bin/python scripts/bench_array.py --write` (all
+parts; about an hour on two busy cores, most of it the cold 72-chip builds).
+`--parts builds,rates,frame,models,cocotb` picks parts (results merge into
+`sim/out/bench_array.json`), `--short` runs the short variants used for the threaded
+rates here, `--thread-counts 2` measures only the threaded builds.
 """
     pat = re.compile(re.escape(SECTION) + r".*?(?=^## |\Z)", re.S | re.M)
     text = pat.sub(body + "\n", text) if pat.search(text) else text.rstrip("\n") + "\n\n" + body
