@@ -21,6 +21,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "sw"))
+sys.path.insert(0, str(REPO / "scripts"))
 
 from diffengine import binfmt, functional, harness, isa, structural, trace  # noqa: E402
 
@@ -58,27 +59,14 @@ def run(exe, src, dst, *args, rc=0) -> subprocess.CompletedProcess:
 
 
 def fst_names_and_times(fst: Path) -> tuple[list[str], list[int]]:
-    """Signal names as GTKWave shows them (scope.path.name[range]) and the time stamps."""
+    """Signal names as GTKWave shows them (scripts/waves.py's reader) and the time stamps."""
+    from waves import fst_signals
+
     out = subprocess.run(["fst2vcd", str(fst)], capture_output=True, text=True,
                          check=True).stdout
-    names, scopes, times, body = [], [], [], False
-    for line in out.splitlines():
-        w = line.split()
-        if not w:
-            continue
-        if body:
-            if w[0].startswith("#"):
-                times.append(int(w[0][1:]))
-        elif w[0] == "$scope":
-            scopes.append(w[2])
-        elif w[0] == "$upscope":
-            scopes.pop()
-        elif w[0] == "$var":
-            rng = w[5] if len(w) > 6 and w[5].startswith("[") else ""
-            names.append(".".join(scopes + [w[4]]) + rng)
-        elif w[0] == "$enddefinitions":
-            body = True
-    return names, times
+    body = out[out.index("$enddefinitions"):]
+    times = [int(ln[1:]) for ln in body.splitlines() if ln.startswith("#")]
+    return fst_signals(fst), times
 
 
 def have_fst2vcd() -> bool:
