@@ -81,7 +81,7 @@ module de_varray
   assign last    = (ph_q == PhW'(Fold - 1));
   assign ph_d    = (rst_i || last) ? '0 : ph_q + 1'b1;
   assign wp_d    = (rst_i || wp_q == WpW'(Fold > 1 ? Fold - 2 : 0)) ? '0 : wp_q + 1'b1;
-  assign rcnt_d  = rst_i ? (PhW + 1)'(Fold - 1) : (rcnt_q != '0 ? rcnt_q - 1'b1 : '0);
+  assign rcnt_d  = (rcnt_q != '0) ? rcnt_q - 1'b1 : '0;
   assign step_o  = (ph_q == '0) && !rst_int;
 
   // ---- input skew (de_skew, advanced once per step) --------------------------------------
@@ -179,7 +179,7 @@ module de_varray
     if (rst_i) begin
       ph_q      <= '0;
       wp_q      <= '0;
-      rcnt_q    <= '0;
+      rcnt_q    <= (PhW + 1)'(Fold - 1);   // clear the other Fold-1 states after rst_i
       sk1_q     <= '0;
       sk2_q     <= '0;
       sk3_q     <= '0;

@@ -100,11 +100,12 @@ class Bench:
         if nz:
             vz = [i for i, b in enumerate(self.v_bus) if b != (0, 0)]
             assert vz, "virtual array bus output stays zero"
-            lag = vz[0] - nz[0]
-            m = len(self.a_bus) - max(lag, 0)
-            assert lag >= 0, f"virtual array bus output ahead of de_array ({lag})"
-            assert self.v_bus[lag:lag + m] == self.a_bus[:m], \
-                f"bus output differs from de_array (lag {lag})"
+            lag = vz[0] - nz[0]   # the latencies differ (de_array: one per chip)
+            v, a = (self.v_bus[lag:], self.a_bus) if lag >= 0 else \
+                (self.v_bus, self.a_bus[-lag:])
+            m = min(len(v), len(a))
+            assert m > len(nz) // 2, f"bus outputs too short to compare ({m})"
+            assert v[:m] == a[:m], f"bus output differs from de_array (lag {lag})"
         frame = np.array(self.v_pix, dtype=np.uint16).reshape(-1, n)
         want = functional.render(cmds, n, carry_bug=carry_bug)
         np.testing.assert_array_equal(frame, want)

