@@ -156,6 +156,28 @@ async def fold_boundaries(dut):
 
 
 @cocotb.test()
+async def reset_mid_stream(dut):
+    """rst_i for one cycle in the middle of a line clears every column's state."""
+    b = await start(dut)
+    n, one = b.n, 1 << 24
+    dirty = [isa.Command("EVAL", 0, n, (5 * one, one // 7)),
+             isa.Command("SETI", 0, n, (3 * one,)), isa.Command("ACCMODE", 0, 0, (1,))]
+    await b.play(isa.serialise(dirty) + [(0, 0)] * 4)
+    d = dut
+    await FallingEdge(d.clk_i)
+    d.rst_i.value = 1
+    await RisingEdge(d.clk_i)
+    d.clk_a_i.value = 1
+    await FallingEdge(d.clk_i)
+    d.clk_a_i.value = 0
+    d.rst_i.value = 0
+    b2 = Bench(dut)
+    cmds = [isa.Command("EVAL", 1, n - 2, (one,)), isa.Command("REFRESH")]
+    await b2.play(spaced(isa.serialise(cmds), n))
+    b2.check(cmds, bug())
+
+
+@cocotb.test()
 async def figure_lists(dut):
     """The seed's Fig. 7.21 / 7.25 command lists (only when the array is wide enough)."""
     b = await start(dut)
