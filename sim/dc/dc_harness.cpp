@@ -394,7 +394,7 @@ int main(int argc, char** argv) {
                 "  \"v_total\": %d,\n  \"chips\": %d,\n  \"num_buf\": %d,\n  \"array_latency\": %d,\n"
                 "  \"frames\": %d,\n  \"cycles\": %llu,\n  \"seconds\": %.6f,\n"
                 "  \"cycles_per_second\": %.1f,\n  \"cpu_seconds\": %.6f,\n"
-                "  \"cycles_per_cpu_second\": %.1f,\n  \"threads\": %u,\n",
+                "  \"cycles_per_cpu_second\": %.1f,\n  \"context_threads\": %u,\n",
                 mode, g.ha, g.va, HT, VT, chips, num_buf, latency, frames,
                 static_cast<unsigned long long>(cycles), secs, cycles / secs, cpu_secs,
                 cycles / cpu_secs, ctx->threads());

@@ -130,6 +130,7 @@ def run(streams, cfg: Config = Config(), mode: int = 0, progress=None,
             raise RuntimeError("dc_harness failed: " + "\n".join(other))
         st = json.loads(stats.read_text())
         st["stderr"] = other
+        st["threads"] = cfg.threads          # the build's Verilator --threads
         if proc.returncode:
             raise RuntimeError("dc_harness check failed: " + "; ".join(st.get("errors", other)))
         return read_dcf(out), st
