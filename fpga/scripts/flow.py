@@ -422,13 +422,15 @@ def varray(args) -> int:
     runs[tag]["pnr"] = {"device": ECP5["name"], "fmax_mhz": fmax_of(rep), "utilization": util,
                         "needs_mhz": round(need, 3),
                         "critical_path": path_summary(rep) if rep else {}}
-    # Slice positions per DPR16X4 as placed: TRELLIS_COMB = LUT4 + 2 CCU2C + k DPR16X4.
+    # LUT4 positions per DPR16X4 as placed: its RAM-mode TRELLIS_COMB cells plus the two
+    # positions of the slice its TRELLIS_RAMW (write port) takes, which no logic can use:
+    # TRELLIS_COMB + 2 RAMW = LUT4 + 2 CCU2C + k DPR16X4.
     cp = runs[tag]["cells"]
     k_dpr = None
     if util.get("TRELLIS_COMB") and cp["TRELLIS_DPR16X4"]:
-        k_dpr = round((util["TRELLIS_COMB"] - cp["LUT4"] - 2 * cp["CCU2C"])
-                      / cp["TRELLIS_DPR16X4"], 2)
-    k = k_dpr if k_dpr is not None else 3.0
+        k_dpr = round((util["TRELLIS_COMB"] + 2 * util.get("TRELLIS_RAMW", 0) - cp["LUT4"]
+                       - 2 * cp["CCU2C"]) / cp["TRELLIS_DPR16X4"], 2)
+    k = k_dpr if k_dpr is not None else 6.0
     full = runs[configs[2][0]]
     fc = full["cells"]
     pos1 = fc["LUT4"] + 2 * fc["CCU2C"] + k * fc["TRELLIS_DPR16X4"]
@@ -465,8 +467,8 @@ def varray_text(rep: dict) -> str:
     pp = rep["per_phys_pe_from_9_minus_1"]
     L.append(f"{'per physical PE (9 - 1) / 8':34}" + "".join(f"{pp[k]:>16}" for k in keys))
     v = rep["verdict"]
-    L += ["", f"Each TRELLIS_DPR16X4 takes {v['comb_positions_per_dpr16x4']} TRELLIS_COMB "
-          "positions as placed (measured on the P&R run below).",
+    L += ["", f"Each TRELLIS_DPR16X4 takes {v['comb_positions_per_dpr16x4']} LUT4 positions as "
+          "placed (RAM-mode TRELLIS_COMB + its RAMW slice; measured on the P&R run below).",
           f"Per physical PE: {v['lut4_positions_per_phys_pe']} LUT4 positions "
           f"-> at most ~{v['max_phys_pe']} physical PEs on the 85F.",
           f"640 columns x 3 colours (3 x 648 columns at this fold): "
