@@ -7,7 +7,7 @@
 
 `run()` does all of it and returns a report dict; scripts/demo.py is its command line.
 Screens other than 640x480 run the controller's test mode (mode 3) with a line of the
-640x480 mode's length (HTotal = 800, so the same 799 slots per line) and a short
+640x480 mode's length (HTotal = 800, so the same 798 usable slots per line) and a short
 vertical blank; the array needs at least as many PEs (9 per chip) as the screen has
 columns.
 """

@@ -61,6 +61,8 @@ class Scene:
     near: float = 0.1
     ambient: float = 0.2
     background: tuple = (1.0, 1.0, 1.0)
+    # `background image FILE`: (H, W, 3) in 1.0 units, scaled to the screen as yproc does
+    background_image: np.ndarray = None
     lights: list = field(default_factory=list)       # [(L unit (3,), I rgb (3,))]
     materials: list = field(default_factory=list)
     # Triangles (after fan triangulation of polygons): world positions (T,3,3), vertex
@@ -166,6 +168,7 @@ def load_scene(path) -> Scene:
     sc.materials = [Material("default", (0.8, 0.8, 0.8))]
     names = {"default": 0}
     tris, norms, mats = [], [], []
+    bg_image = None
     for lineno, line in enumerate(text.splitlines(), 1):
         tok = _tokens(line)
         if not tok:
@@ -198,6 +201,8 @@ def load_scene(path) -> Scene:
             sc.lights.append((L / np.linalg.norm(L), np.array(rgb, dtype=np.float64)))
         elif k == "ambient":
             sc.ambient = _nums(tok[1:], 1, where)[0]
+        elif k == "background" and len(tok) == 3 and tok[1] == "image":
+            bg_image = (path.parent / tok[2], where)
         elif k == "background":
             sc.background = tuple(_nums(tok[1:], 3, where))
         elif k == "material":
@@ -248,7 +253,43 @@ def load_scene(path) -> Scene:
     flat = np.array([sc.materials[m].flat for m in midx], dtype=bool)
     nv[flat] = fnorm[flat][:, None, :]
     sc.nrm, sc.mat = nv, midx
+    if bg_image is not None:
+        sc.background_image = _read_ppm(*bg_image, sc.width, sc.height)
     return sc
+
+
+def _read_ppm(path: Path, where: str, W: int, H: int) -> np.ndarray:
+    """A binary PPM (P6) as (H, W, 3) in 1.0 units: quantised to 12 bits and scaled to
+    the screen by nearest neighbour exactly as yproc's read_ppm (yp_shade.c)."""
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise SceneError(f"{where}: cannot read background image {path} ({e.strerror})") from None
+    fields, pos = [], 0
+    while len(fields) < 4:
+        while pos < len(data) and data[pos:pos + 1].isspace():
+            pos += 1
+        end = pos
+        while end < len(data) and not data[end:end + 1].isspace():
+            end += 1
+        fields.append(data[pos:end])
+        pos = end
+    try:
+        magic, w, h, maxv = fields[0], int(fields[1]), int(fields[2]), int(fields[3])
+    except ValueError:
+        magic = None
+    if magic != b"P6" or not (0 < maxv < 65536) or w < 1 or h < 1:
+        raise SceneError(f"{where}: {path}: not a binary PPM (P6)")
+    pos += 1
+    dt = np.dtype(">u2") if maxv > 255 else np.dtype("u1")
+    n = 3 * w * h
+    if len(data) - pos < n * dt.itemsize:
+        raise SceneError(f"{where}: {path}: truncated")
+    src = np.frombuffer(data, dtype=dt, count=n, offset=pos).reshape(h, w, 3).astype(np.float64)
+    src = _llround(src * 4095.0 / maxv)
+    sy = (np.arange(H) * h) // H
+    sx = (np.arange(W) * w) // W
+    return src[sy][:, sx] / 4095.0
 
 
 def _llround(v: np.ndarray) -> np.ndarray:
@@ -441,7 +482,11 @@ def render(sc: Scene, samples: int = 16, band: int = 16, quantise: bool = True,
         blk = io.reshape(y1 - y0, S, W, S)
         edges[y0:y1] = blk.min(axis=(1, 3)) != blk.max(axis=(1, 3))
         col = shade(zo, io, l1o, l2o)
-        col[io < 0] = bg
+        if sc.background_image is None:
+            col[io < 0] = bg
+        else:   # every sample takes the background of its own pixel
+            img = np.repeat(np.repeat(sc.background_image[y0:y1], S, axis=0), S, axis=1)
+            col[io < 0] = img[io < 0]
         ttri = tri[~opaque[tri]]
         if len(ttri):
             # depth peeling of the transparent layers in front of the opaque surface,

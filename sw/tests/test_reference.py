@@ -233,3 +233,25 @@ def test_flat_material_and_near_clip(tmp_path):
     # at y = 16 + 16 * (1 - 1.5 * 3.5 / 8) / 0.5 = 27
     rows = np.flatnonzero((img2 > 0).any(1))
     assert rows.min() == 20 and rows.max() == 26 and (img2[26] > 0).all()
+
+
+def test_background_image_scaled_like_yproc(tmp_path):
+    # a 2x2 16-bit PPM on a 32x32 screen: nearest neighbour, each source pixel a 16x16
+    # quadrant, quantised to 12 bits; no geometry, so the frame is the picture itself
+    px = np.array([[[65535, 0, 0], [0, 65535, 0]], [[0, 0, 65535], [32768, 32768, 32768]]])
+    (tmp_path / "bg.ppm").write_bytes(b"P6\n2 2\n65535\n" + px.astype(">u2").tobytes())
+    sc = write(tmp_path, CAM + "background image bg.ppm\n", {})
+    img = ref.render_file(sc)
+    assert img[0, 0].tolist() == [S, 0, 0] and img[31, 0].tolist() == [0, 0, S]
+    assert img[0, 31].tolist() == [0, S, 0]
+    np.testing.assert_allclose(img[31, 31], [round(32768 * S / 65535)] * 3, atol=1e-9)
+
+
+@pytest.mark.parametrize("data,msg", [(None, "cannot read"), (b"P5\n1 1\n255\n\0", "not a binary PPM"),
+                                      (b"P6\n2 2\n255\n\0\0\0", "truncated")])
+def test_background_image_bad_file_names_scene_line(tmp_path, data, msg):
+    if data is not None:
+        (tmp_path / "bg.ppm").write_bytes(data)
+    sc = write(tmp_path, CAM + "\nbackground image bg.ppm\n", {})
+    with pytest.raises(ref.SceneError, match=rf"s.scene:4: .*{msg}"):
+        ref.load_scene(sc)

@@ -39,7 +39,7 @@ void yp_cmdlist_free(yp_cmdlist *l)
 
 void yp_options_default(yp_options *o)
 {
-    o->capacity = 799; o->aa = 1; o->shading = YP_PHONG; o->tol = 1.0;
+    o->capacity = 798; o->aa = 1; o->shading = YP_PHONG; o->tol = 1.0;
 }
 
 int yp_mode_capacity(const char *mode, int *width, int *height)
@@ -50,7 +50,9 @@ int yp_mode_capacity(const char *mode, int *width, int *height)
         if (!strcmp(mode, modes[i].name)) {
             if (width) *width = modes[i].w;
             if (height) *height = modes[i].h;
-            return modes[i].htotal - 1;
+            /* HTotal - 2: the window has HTotal - 1 slots, and the end-of-line
+             * marker must reach the buffer's head inside it (docs/pipeline.md 1.1) */
+            return modes[i].htotal - 2;
         }
     return 0;
 }
