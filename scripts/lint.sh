@@ -24,6 +24,20 @@ for f in rtl/ctrl/*.sv; do
     lint_top "$top" $(ls rtl/ctrl/*.sv | grep -v display_controller)
   fi
 done
+# board top: the whole design; the other board blocks stand alone
+ctrl=($(ls rtl/ctrl/*.sv))
+lint_top de_board_core "${array[@]}" rtl/proto/de_instr_lut.sv rtl/proto/de_data_mapper.sv \
+  "${ctrl[@]}" rtl/board/*.sv
+for f in rtl/board/*.sv; do
+  case $f in
+    */de_board_core.sv) ;;
+    */de_fs_player.sv) lint_top de_fs_player rtl/proto/de_instr_lut.sv rtl/proto/de_data_mapper.sv "$f" ;;
+    *) lint_top "$(basename "$f" .sv)" "$f" ;;
+  esac
+done
+# virtual array: de_vpe.sv is generated from de_pe.sv (rtl/varray/gen_vpe.py)
+python3 rtl/varray/gen_vpe.py build/varray/de_vpe.sv >/dev/null
+lint_top de_varray $pkg build/varray/de_vpe.sv rtl/varray/de_varray.sv
 if ! verible-verilog-lint $(find rtl -name '*.sv' | sort); then fail=1; fi
 [[ $fail -eq 0 ]] && echo "lint: clean ($(find rtl -name '*.sv' | wc -l) files)"
 exit $fail
