@@ -15,19 +15,28 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: sim fuzz-hsr help setup demo test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: sim fuzz-hsr help setup demo demo-cmd bench-array fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
-	@echo "make demo        render the shipped default command file to out/demo.png"
+	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
+	@echo "                 controller (3 x 72 chips) and golden model -> out/demo.png, PSNR"
+	@echo "                 (SCENE=file.scene CHIPS=72 THREADS=1 RTL=0 for model only;"
+	@echo "                 first run builds the 648-PE model: ~15 min on 2 cores, then ~8 min)"
+	@echo "make demo-cmd    one command file through the golden model (DEMO_FILE=...)"
 	@echo "make test        run every test (sets itself up on first use)"
 	@echo "make sim         RTL regression vs golden model, HTML/JUnit reports (TIER=smoke|full|nightly J=2)"
 	@echo "make test-long   long random regressions (not part of make test)"
-	@echo "make bench       speed benchmarks, recorded in docs/performance.md"
+	@echo "make bench       golden model speed, y-processor commands per line and host time"
+	@echo "                 (docs/performance.md)"
+	@echo "make bench-hsr   HSR benchmarks (Table 5.2, Fig 5.30) into docs/performance.md"
+	@echo "make bench-array Verilated array speed (1/8/72 chips) vs the models"
 	@echo "make waves TEST=<cocotb test> [PE=p] [BUG=0|1]"
 	@echo "                 FST + GTKWave save file for one PE (docs/debugging.md)"
 	@echo "make lint        verilator -Wall and verible lint on every RTL file"
-	@echo "make fpga        yosys + nextpnr: one 9-PE chip on ECP5 and iCE40, 640-PE fit (fpga/)"
-	@echo "make bench-hsr   HSR benchmarks (Table 5.2, Fig 5.30) into docs/performance.md"
+	@echo "make fpga        yosys + nextpnr: 9-PE chip on ECP5 and iCE40, 640-PE fit, virtual"
+	@echo "                 array, ULX3S board bitstream (fpga/, docs/fpga.md, docs/board.md)"
+	@echo "make fpga-board  only the ULX3S bitstream (fpga/ulx3s)"
+	@echo "make postsynth   yosys netlists simulated in Icarus against the golden model"
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
 	@echo "make setup       create .venv from scripts/requirements.txt"
 	@echo "make clean       remove build products (keeps .venv)"
@@ -36,11 +45,21 @@ setup: $(SETUP)
 $(SETUP): scripts/setup.sh scripts/requirements.txt sw/pyproject.toml
 	./scripts/setup.sh
 
+# The main job (docs/pipeline.md): RTL=0 skips the Verilated controller.
+SCENE ?= sw/scenes/teapot/teapot.scene
+CHIPS ?= 72
+THREADS ?= 1
+RTL ?= 1
 demo: $(SETUP)
+	$(ENV) $(PY) scripts/demo.py --scene $(SCENE) --chips $(CHIPS) --threads $(THREADS) \
+	  --out $(OUT) $(if $(filter 0,$(RTL)),--no-rtl,)
+
+# One command file through the golden model (the first demo, before the pipeline).
+demo-cmd: $(SETUP)
 	@mkdir -p $(OUT)
-	$(ENV) $(DE) model $(DEMO_FILE) -o $(OUT)/demo.png
-	$(ENV) $(DE) plot $(DEMO_FILE) -o $(OUT)/demo_scanlines.png
-	@echo "demo: wrote $(OUT)/demo.png and $(OUT)/demo_scanlines.png"
+	$(ENV) $(DE) model $(DEMO_FILE) -o $(OUT)/demo_cmd.png
+	$(ENV) $(DE) plot $(DEMO_FILE) -o $(OUT)/demo_cmd_scanlines.png
+	@echo "demo-cmd: wrote $(OUT)/demo_cmd.png and $(OUT)/demo_cmd_scanlines.png"
 
 # make test = Python model tests + C host tests (if present) + RTL tests (if present).
 test: test-py test-c test-rtl
@@ -57,12 +76,13 @@ fuzz-hsr:
 	$(MAKE) -C sw/hsr/fuzz long
 
 test-rtl: $(SETUP)
-	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 .; fi
+	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 --durations=12 .; fi
 
 # The RTL regression (docs/regression.md): TIER=smoke|full|nightly, J parallel jobs.
 TIER ?= full
 J ?= 2
 sim: $(SETUP)
+	@$(MAKE) -s -C sw/hsr build/yproc
 	$(ENV) cd sw && $(PY) -m diffengine.regress --tier $(TIER) -j $(J)
 
 # 10^7 random commands per array configuration through the RTL (hours on 2 cores).
@@ -84,6 +104,16 @@ bench-hsr: $(SETUP)
 
 bench: $(SETUP)
 	$(ENV) $(PY) scripts/bench_model.py --write
+	$(ENV) $(PY) scripts/bench_yproc.py --write
+
+bench-array: $(SETUP)
+	$(ENV) $(PY) scripts/bench_array.py --write
+
+fpga-board: $(SETUP)
+	$(MAKE) -C fpga/ulx3s
+
+postsynth: $(SETUP)
+	$(MAKE) -C fpga postsynth
 
 clean:
 	rm -rf $(OUT) build sim/out
