@@ -15,13 +15,14 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: sim fuzz-hsr help setup demo demo-cmd bench-array fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: sim fuzz-hsr help setup demo demo-cmd anim bench-array fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
 	@echo "                 controller (3 x 72 chips) and golden model -> out/demo.png, PSNR"
 	@echo "                 (SCENE=file.scene CHIPS=72 THREADS=1 RTL=0 for model only;"
 	@echo "                 first run builds the 648-PE model: ~15 min on 2 cores, then ~8 min)"
+	@echo "make anim        the shipped animation through incremental frame deltas -> out/anim"
 	@echo "make demo-cmd    one command file through the golden model (DEMO_FILE=...)"
 	@echo "make test        run every test (sets itself up on first use)"
 	@echo "make sim         RTL regression vs golden model, HTML/JUnit reports (TIER=smoke|full|nightly J=2)"
@@ -53,6 +54,11 @@ RTL ?= 1
 demo: $(SETUP)
 	$(ENV) $(PY) scripts/demo.py --scene $(SCENE) --chips $(CHIPS) --threads $(THREADS) \
 	  --out $(OUT) $(if $(filter 0,$(RTL)),--no-rtl,)
+
+# The shipped animation through incremental frame deltas (out/anim: PNGs and a GIF).
+ANIM ?= sw/scenes/anim/cad_drag.anim
+anim: $(SETUP)
+	$(ENV) $(PY) scripts/anim.py --anim $(ANIM) --out $(OUT)/anim
 
 # One command file through the golden model (the first demo, before the pipeline).
 demo-cmd: $(SETUP)
