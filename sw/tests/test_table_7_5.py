@@ -48,3 +48,24 @@ def test_compensated_pixels_differ_only_in_lsb():
     right = [int(r[1].split(".")[0], 16) for r in ROWS]
     comp = [int(r[5].split(".")[0], 16) for r in ROWS]
     assert all(abs(a - b) <= 1 for a, b in zip(right, comp)) and right != comp
+
+
+@pytest.mark.parametrize("pair,bug,comp", [(0, False, False), (1, True, False), (2, True, True)],
+                         ids=["correct", "erroneous", "compensated"])
+def test_table_7_5_structural(pair, bug, comp):
+    """The cycle-level model gives the same three column pairs. The compensation is the
+    data mapper's (binfmt.compensate_slots, what the prototype's mapper does to the
+    serialised slots in front of the array), so the fault and its repair meet exactly
+    where they do in hardware."""
+    from diffengine import binfmt, structural
+
+    slots = isa.serialise([isa.Command("EVAL", 0, 9, (0, 0, DDI))])
+    if comp:
+        slots = binfmt.compensate_slots(slots)
+    arr = structural.Array(9, carry_bug=bug)
+    arr.run(slots)
+    arr.flush()
+    s = arr.state()
+    got = [(isa.format_fixed(int(b))[2:], isa.format_fixed(int(a))[2:])
+           for b, a in zip(s["B"], s["A"])]
+    assert got == [(r[2 * pair], r[2 * pair + 1]) for r in ROWS]
