@@ -36,31 +36,39 @@ class PipelineError(RuntimeError):
 
 
 class Progress:
-    """A one-line text progress bar on stderr (only when stderr is a terminal, or
-    always with force=True); `None`-safe to call from callbacks."""
+    """Progress on stderr: a one-line bar on a terminal (or always with force=True);
+    elsewhere (logs, CI) a plain line every 10 %. `None`-safe to call from callbacks."""
 
     def __init__(self, label: str, enabled: bool = True, force: bool = False):
         self.label = label
-        self.on = enabled and (force or sys.stderr.isatty())
+        self.tty = force or sys.stderr.isatty()
+        self.on = enabled
         self.t0 = time.monotonic()
         self.last = 0.0
+        self.step = 0
 
     def __call__(self, done: float, total: float) -> None:
         if not self.on or total <= 0:
             return
         now = time.monotonic()
+        frac = min(1.0, done / total)
+        el = now - self.t0
+        eta = el / frac - el if frac > 0 else 0
+        if not self.tty:
+            if int(10 * frac) > self.step:
+                self.step = int(10 * frac)
+                print(f"  {self.label:<10} {100 * frac:5.1f} %  {el:7.1f} s  (eta {eta:7.1f} s)",
+                      file=sys.stderr, flush=True)
+            return
         if now - self.last < 0.2 and done < total:
             return
         self.last = now
-        frac = min(1.0, done / total)
         bar = "#" * int(30 * frac) + "." * (30 - int(30 * frac))
-        el = now - self.t0
-        eta = el / frac - el if frac > 0 else 0
         print(f"\r  {self.label:<10} [{bar}] {100 * frac:5.1f} %  {el:6.1f} s"
               f"  (eta {eta:5.1f} s) ", end="", file=sys.stderr, flush=True)
 
     def close(self) -> None:
-        if self.on:
+        if self.on and self.tty:
             print("\r" + " " * 79 + "\r", end="", file=sys.stderr, flush=True)
 
 
