@@ -37,12 +37,10 @@ def pe_scope(bench: str, pe: int) -> str:
     return f"de_array.g_chip[{chip}].u_chip.g_pe[{i}].u_pe"
 
 
-def fst_signals(fst: Path) -> list[str]:
-    """Every signal in the dump as GTKWave names it: scope.path.name[range]."""
-    out = subprocess.run(["fst2vcd", str(fst)], capture_output=True, text=True,
-                         check=True).stdout
-    names, scopes = [], []
-    for line in out.splitlines():
+def vcd_vars(vcd: str):
+    """(scope list, $var words) for every variable in a VCD header."""
+    scopes = []
+    for line in vcd.splitlines():
         w = line.split()
         if not w:
             continue
@@ -51,10 +49,19 @@ def fst_signals(fst: Path) -> list[str]:
         elif w[0] == "$upscope":
             scopes.pop()
         elif w[0] == "$var":
-            rng = w[5] if len(w) > 6 and w[5].startswith("[") else ""
-            names.append(".".join(scopes + [w[4]]) + rng)
+            yield list(scopes), w
         elif w[0] == "$enddefinitions":
-            break
+            return
+
+
+def fst_signals(fst: Path) -> list[str]:
+    """Every signal in the dump as GTKWave names it: scope.path.name[range]."""
+    out = subprocess.run(["fst2vcd", str(fst)], capture_output=True, text=True,
+                         check=True).stdout
+    names = []
+    for scopes, w in vcd_vars(out):
+        rng = w[5] if len(w) > 6 and w[5].startswith("[") else ""
+        names.append(".".join(scopes + [w[4]]) + rng)
     return names
 
 

@@ -21,24 +21,18 @@ REPO = Path(__file__).resolve().parents[2]
 def _vcd_values(fst: Path, scope: str) -> dict[str, set[int]]:
     """Every value each signal directly in `scope` (dotted) takes, from fst2vcd."""
     vcd = subprocess.run(["fst2vcd", str(fst)], capture_output=True, text=True, check=True).stdout
-    scopes, ids, vals = [], {}, {}
-    lines = iter(vcd.splitlines())
-    for line in lines:
-        w = line.split()
-        if not w:
-            continue
-        if w[0] == "$scope":
-            scopes.append(w[2])
-        elif w[0] == "$upscope":
-            scopes.pop()
-        elif w[0] == "$var" and ".".join(scopes).endswith(scope):
+    sys.path.insert(0, str(REPO / "scripts"))
+    from waves import vcd_vars
+
+    ids, vals = {}, {}
+    for scopes, w in vcd_vars(vcd):
+        if ".".join(scopes).endswith(scope):
             name = w[4] + (w[5] if len(w) > 6 and w[5].startswith("[") and ":" not in w[5] else "")
             ids.setdefault(w[3], []).append(name)
-        elif w[0] == "$var" and ".".join(scopes[:-1]).endswith(scope):
+        elif ".".join(scopes[:-1]).endswith(scope):
             # unpacked arrays / structs: one sub-scope per element (out_q -> out_q[2])
             ids.setdefault(w[3], []).append(f"{scopes[-1]}.{w[4]}")
-        elif w[0] == "$enddefinitions":
-            break
+    lines = iter(vcd.split("$enddefinitions", 1)[1].splitlines())
     for line in lines:
         if not line or line[0] in "#$":
             continue
