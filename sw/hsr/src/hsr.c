@@ -153,6 +153,70 @@ static int classify_add(uint64_t db, uint64_t cb, void *vctx)
     return 2 + pos;
 }
 
+static int split_front(hsr_domain *const *res, int k)
+{
+    for (int pos = 0; pos <= k; pos++) if (!hsr_domain_is_empty(res[2 + pos])) return 1;
+    return 0;
+}
+
+/* The parents of LLR domain s join the accumulated hidden list acc of the
+ * domain being added (deduplicated by mark_acc). */
+static hsr_status acc_parents(hsr_ctx *h, int s, ivec *acc, unsigned acc_mark)
+{
+    const llr *N = &h->l[s];
+    hsr_status st = HSR_OK;
+    for (int i = 0; i < N->par.n; i++) {
+        int p = N->par.v[i];
+        if (h->m[p].mark_acc == acc_mark) continue;
+        h->m[p].mark_acc = acc_mark;
+        if (!iv_push(acc, p)) st = HSR_ENOMEM;
+    }
+    return st;
+}
+
+/* LLR domain s is wholly covered by the domain being added: its parents join
+ * acc and s goes. */
+static hsr_status absorb(hsr_ctx *h, int s, ivec *acc, unsigned acc_mark)
+{
+    hsr_status st = acc_parents(h, s, acc, acc_mark);
+    llr_destroy(h, s);
+    return st;
+}
+
+/* Slot s (wholly covered by opaque MLR domain id, in front) becomes id's new
+ * LLR domain dom: id is its only visible parent, N's former visible parents
+ * become hidden (moved from their visibles to their invisibles), the hidden
+ * ones stay where they are (no work per hidden parent), and the parents in
+ * acc are appended unless already listed (looked up in the parent's own lists,
+ * which are short, not in the slot's long one). */
+static hsr_status adopt(hsr_ctx *h, int s, int id, hsr_domain *dom, const ivec *acc)
+{
+    llr *L = &h->l[s];
+    hsr_status st = HSR_OK;
+    hsr_gridlist_remove(h->grid, s);
+    hsr_domain_free(L->dom);
+    L->dom = dom;
+    for (int i = 0; i < L->nvis; i++) {
+        ivec *v = &h->m[L->par.v[i]].vis;
+        iv_del(v, s);
+        if (!iv_push(&h->m[L->par.v[i]].invis, s)) st = HSR_ENOMEM;
+    }
+    if (iv_find(&h->m[id].invis, s) >= 0) {   /* a re-add that N listed as hidden: rare */
+        iv_del(&L->par, id);
+        iv_del(&h->m[id].invis, s);
+    }
+    /* id goes first; the old first parent moves to the (unordered) hidden end */
+    if (!iv_push(&L->par, L->par.v[0]) || !iv_push(&h->m[id].vis, s)) st = HSR_ENOMEM;
+    else { L->par.v[0] = id; L->nvis = 1; }
+    for (int i = 0; i < acc->n && st == HSR_OK; i++) {
+        int p = acc->v[i];
+        if (p == id || !h->m[p].present || iv_find(&h->m[p].invis, s) >= 0 || iv_find(&h->m[p].vis, s) >= 0) continue;
+        if (!iv_push(&L->par, p) || !iv_push(&h->m[p].invis, s)) st = HSR_ENOMEM;
+    }
+    hsr_status s2 = hsr_gridlist_insert(h->grid, s, dom->ext);
+    return st != HSR_OK ? st : s2;
+}
+
 static hsr_status add_domain(hsr_ctx *h, int id)
 {
     hsr_status st = HSR_OK;
@@ -162,6 +226,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
     ivec cand = {0, 0, 0}, acc = {0, 0, 0}, tail = {0, 0, 0};
     if (!rem) return HSR_ENOMEM;
     unsigned acc_mark = next_stamp(h);
+    int keep = -1;   /* a slot wholly covered by I, reused for I's new domain */
     hsr_gridlist_query(h->grid, rem->ext, collect, &cand);
     for (int ci = 0; ci < cand.n && !hsr_domain_is_empty(rem); ci++) {
         int s = cand.v[ci];
@@ -208,17 +273,24 @@ static hsr_status add_domain(hsr_ctx *h, int id)
             if (!listed && (!iv_push(&N->par, id) || !iv_push(&h->m[id].invis, s))) { st = HSR_ENOMEM; goto done; }
             continue;
         }
+        if (c.covered && hsr_domain_is_empty(res[1]) && !split_front(res, c.k)) {
+            /* I is opaque and in front of all of N: N disappears into the new
+             * domain, which inherits all of N's parents as hidden ones.  Keep the
+             * slot with the longest parent list for the new domain instead of
+             * copying that list (Fig. 5.30 tri-spets reversed: every new triangle
+             * covers the one domain holding all earlier ones, O(n) per add). */
+            for (int i = 1; i < nlab; i++) hsr_domain_free(res[i]);
+            if (keep >= 0 && h->l[keep].par.n >= N->par.n) { st = absorb(h, s, &acc, acc_mark); }
+            else { if (keep >= 0) st = absorb(h, keep, &acc, acc_mark); keep = s; }
+            if (st != HSR_OK) goto done;
+            continue;
+        }
         /* N is replaced by its pieces; copy its parents first */
         int pre[HSR_MAX_PREFIX + 1], k = c.k;
         memcpy(pre, N->par.v, sizeof(int) * (size_t)k);
         tail.n = 0;
         for (int i = k; i < N->par.n; i++) iv_push(&tail, N->par.v[i]);
-        for (int i = 0; c.covered && i < N->par.n; i++) {
-            int p = N->par.v[i];
-            if (h->m[p].mark_acc == acc_mark) continue;
-            h->m[p].mark_acc = acc_mark;
-            if (!iv_push(&acc, p)) st = HSR_ENOMEM;
-        }
+        if (c.covered) st = acc_parents(h, s, &acc, acc_mark);
         llr_destroy(h, s);
         if (c.hidden) iv_add(&tail, id);
         if (!hsr_domain_is_empty(res[1])) { st = llr_create(h, res[1], pre, k, &tail); res[1] = NULL; }
@@ -241,8 +313,10 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         hsr_domain_free(res[1]);
         if (st != HSR_OK) goto done;
     }
-    if (!hsr_domain_is_empty(rem)) { st = llr_create(h, rem, &id, 1, &acc); rem = NULL; }
+    if (keep >= 0 && !hsr_domain_is_empty(rem)) { st = adopt(h, keep, id, rem, &acc); rem = NULL; keep = -1; }
+    else if (!hsr_domain_is_empty(rem)) { st = llr_create(h, rem, &id, 1, &acc); rem = NULL; }
 done:
+    if (keep >= 0) llr_destroy(h, keep);   /* error: no stale domain overlapping the new pieces */
     hsr_domain_free(rem);
     free(cand.v); free(acc.v); free(tail.v);
     return st;
