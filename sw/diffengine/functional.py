@@ -17,14 +17,18 @@ A span is split only where a protect flag relevant to the Eval's order is raised
 With the §7.7 carry bug the adder is not linear, so those Evals take a per-column
 Python path through `bug_add` (correct, slower; only tests and demos use it).
 
-Lines that hold nothing but Eval1..Eval3 (plus Nop/Refresh) are by far the common
-case and are rendered for the whole frame at once (`_render_batch`): each span adds a
-polynomial in the binomial basis, which becomes six impulses in three difference
-arrays; three cumulative sums per row give every D.
+`render` batches every line whose Evals are all Eval1..Eval3 (`_Plan`), which is by far
+the common case, Set/SetP/Dis/Eval0/Acc_mode included: a scalar walk of each line turns
+its Evals into polynomial pieces (cut where a protect flag substitutes a register, split
+around disabled columns), each piece becomes six impulses in three difference arrays,
+and three cumulative sums per row give every D for the whole frame at once. Lines with
+Eval4+ or the carry bug go through the per-command path (`run_line`), which is also the
+reference the batch is tested against (`_render_reference`).
 """
 from __future__ import annotations
 
 import warnings
+from bisect import bisect_left
 from dataclasses import dataclass
 from math import comb
 
@@ -273,56 +277,202 @@ def run_line(commands, width: int = 640, carry_bug: bool = False) -> tuple[np.nd
     return line.s.pixels(), line.s
 
 
-_BATCH_OPS = {"EVAL", "NOP", "REFRESH"}
+_W = isa.WORD_MASK
 
 
-def _batchable(line) -> bool:
-    return all(c.op in _BATCH_OPS and c.order <= 2 for c in line)
+def _advance(v0: int, v1: int, v2: int, n: int) -> tuple[int, int, int]:
+    """Differences (order <= 2) n columns further on: sum_k C(n, k) v_{j+k} mod 2^36."""
+    return ((v0 + n * v1 + (n * (n - 1) >> 1) * v2) & _W, (v1 + n * v2) & _W, v2)
 
 
-def _render_batch(lines: list[list[isa.Command]], width: int) -> np.ndarray:
-    """Pixels of lines holding only Eval1..3: all lines at once via difference arrays.
+class _Plan:
+    """Frame-wide batch of lines whose Evals are all of order <= 2 (no carry bug).
 
-    A span [s, s+L) adding f(m) = a + b*m + c*C(m,2) (m = column - s) is the impulses
-    G1[s] += a, G2[s+1] += b, G3[s+2] += c, and, so that f stops at e = s+L, the
-    continuation a + bL + cC(L,2) + (b + cL)m' + cC(m',2) (m' = column - e, Vandermonde)
-    subtracted at e, e+1, e+2. D = cumsum(G1 + cumsum(G2 + cumsum(G3))).
+    Each line is walked command by command with Python scalars only: the protect, dis and
+    lock flags that are raised are few, so they live in dicts keyed by column (a protect
+    dict holds the register value its Set wrote, which is what the flag substitutes), with
+    sorted key lists for range queries. An Eval becomes pieces [s, t) that each add one
+    polynomial val0(m) = v0 + m v1 + C(m, 2) v2 to D: the Eval is cut where a relevant
+    protect flag substitutes a register (exactly the cuts of `_Line.eval`), and a cut
+    piece is split again around columns whose dis flag suppresses the ACC. Pieces with
+    Acc_mode off go into difference arrays (`_finish`); with Acc_mode on, the sign of
+    every value matters, so they are expanded column by column (vectorised at the end).
+    Eval0 locks D, and nothing changes a locked D, so the first Eval0 that gets through
+    simply overrides the column's final D.
     """
-    rows, xs, dxs, a, b, c = [], [], [], [], [], []
-    for i, line in enumerate(lines):
-        for cmd in line:
-            if cmd.op == "EVAL":
-                v = cmd.values
-                rows.append(i)
-                xs.append(cmd.x)
-                dxs.append(cmd.dx)
-                a.append(v[0])
-                b.append(v[1] if len(v) > 1 else 0)
-                c.append(v[2] if len(v) > 2 else 0)
-    stride = width + 3
-    g = np.zeros((3, len(lines) * stride), dtype=np.uint64)
-    if rows:
-        x = np.array(xs, dtype=np.int64)
-        n = np.minimum(np.array(dxs, dtype=np.int64), width - x)
-        keep = n > 0
-        x, n = x[keep], n[keep]
-        base = np.array(rows, dtype=np.int64)[keep] * stride + x
-        # signed 36-bit values -> uint64 (mod 2^64 is a multiple of mod 2^36)
-        ua, ub, uc = (np.array(t, dtype=np.int64)[keep].view(np.uint64) for t in (a, b, c))
-        nu = n.astype(np.uint64)
-        tri = (nu * (nu - np.uint64(1))) >> np.uint64(1)  # C(L,2), exact: n < 2^32
-        end = base + n
-        np.add.at(g[0], base, ua)
-        np.add.at(g[1], base + 1, ub)
-        np.add.at(g[2], base + 2, uc)
-        np.add.at(g[0], end, (ua + ub * nu + uc * tri) * np.uint64(_U64))  # times -1
-        np.add.at(g[1], end + 1, (ub + uc * nu) * np.uint64(_U64))
-        np.add.at(g[2], end + 2, uc * np.uint64(_U64))
-    g = g.reshape(3, len(lines), stride)
-    d = np.cumsum(g[0] + np.cumsum(g[1] + np.cumsum(g[2], axis=1, dtype=np.uint64),
-                                   axis=1, dtype=np.uint64), axis=1, dtype=np.uint64)
-    d = d[:, :width] & MASK
-    return ((d >> np.uint64(isa.FRAC_BITS)) & np.uint64(isa.BLOCK_MASK)).astype(np.uint16)
+
+    def __init__(self, width: int):
+        self.width = width
+        self.stride = width + 3
+        self.poly: list[tuple[int, int, int, int, int]] = []  # flat start, n, v0, v1, v2
+        self.expl: list[tuple[int, int, int, int, int]] = []  # the same, Acc_mode on
+        self.over: list[tuple[int, int]] = []  # flat column, Eval0 intensity
+
+    def line(self, row: int, cmds) -> None:
+        w = self.width
+        base = row * self.stride
+        poly, expl = self.poly, self.expl
+        pv: list[dict[int, int]] = [{}, {}, {}]  # A, B, C: column -> Set value
+        pk: list[list[int]] = [[], [], []]  # sorted keys of pv
+        dis: set[int] = set()
+        dk: list[int] = []
+        lock: dict[int, int] = {}
+        acc = False
+        for c in cmds:
+            op = c.op
+            if op == "EVAL":
+                a = c.x if c.x < w else w
+                e = c.x + c.dx
+                if e > w:
+                    e = w
+                if e <= a:
+                    continue
+                vals = c.values
+                p = len(vals) - 1
+                v0 = vals[0] & _W
+                v1 = vals[1] & _W if p >= 1 else 0
+                v2 = vals[2] & _W if p >= 2 else 0
+                if not (pk[0] or pk[1] or pk[2] or dk or acc):  # the common case
+                    poly.append((base + a, e - a, v0, v1, v2))
+                    continue
+                cuts = {a}
+                for r in range(p + 1):
+                    ks = pk[r]
+                    if ks:
+                        i, j = bisect_left(ks, a), bisect_left(ks, e)
+                        if i < j:
+                            cuts.update(ks[i:j])
+                cuts = sorted(cuts)
+                cuts.append(e)
+                out = expl if acc else poly
+                for k in range(len(cuts) - 1):
+                    s, t = cuts[k], cuts[k + 1]
+                    if s in pv[0]:  # protect flags substitute the incoming differences
+                        v0 = pv[0][s]
+                    if p >= 1 and s in pv[1]:
+                        v1 = pv[1][s]
+                    if p >= 2 and s in pv[2]:
+                        v2 = pv[2][s]
+                    q = s
+                    if dk:  # columns whose ACC a Dis suppresses: skip them
+                        i, j = bisect_left(dk, s), bisect_left(dk, t)
+                        for col in dk[i:j]:
+                            if col > q:
+                                out.append((base + q, col - q, *_advance(v0, v1, v2, q - s)))
+                            q = col + 1
+                    if t > q:
+                        out.append((base + q, t - q, *_advance(v0, v1, v2, q - s)))
+                    v0, v1, v2 = _advance(v0, v1, v2, t - s)
+                self._clear(a, e, pv, pk, dis, dk)
+            elif op in ("SETI", "SETDI", "SETDDI", "SETPI", "SETPDI", "SETPDDI"):
+                r = isa.SET_REG[op] - isa.REG_A
+                if op.startswith("SETP"):
+                    cols = range(min(c.x, w), w, c.dx if c.dx else 4096)
+                else:
+                    cols = range(min(c.x, w), min(c.x + c.dx, w))
+                if cols:
+                    pv[r].update(dict.fromkeys(cols, c.values[0] & _W))
+                    pk[r] = sorted(pv[r])
+            elif op == "DIS":
+                cols = range(min(c.x, w), min(c.x + c.dx, w))
+                if cols:
+                    dis.update(cols)
+                    dk = sorted(dis)
+            elif op == "EVAL0":
+                a, e = min(c.x, w), min(c.x + c.dx, w)
+                if e <= a:
+                    continue
+                for col in range(a, e):
+                    if col not in lock and col not in dis:
+                        lock[col] = c.values[0]
+                dk = self._clear(a, e, pv, pk, dis, dk)
+            elif op == "ACCMODE":
+                acc = bool(c.values[0])
+            elif op == "NOP" or op == "REFRESH":
+                pass
+            else:
+                raise ValueError(f"unknown command {op!r}")
+        self.over.extend((base + col, i) for col, i in lock.items())
+
+    @staticmethod
+    def _clear(a, e, pv, pk, dis, dk):
+        """End of an Eval active in [a, e): its protect and dis flags drop."""
+        for r in range(3):
+            ks = pk[r]
+            if ks:
+                i, j = bisect_left(ks, a), bisect_left(ks, e)
+                if i < j:
+                    for col in ks[i:j]:
+                        del pv[r][col]
+                    del ks[i:j]
+        if dk:
+            i, j = bisect_left(dk, a), bisect_left(dk, e)
+            if i < j:
+                dis.difference_update(dk[i:j])
+                del dk[i:j]
+        return dk
+
+    def finish(self, n_lines: int) -> np.ndarray:
+        """Pixels of every planned line.
+
+        A piece at s of length L adding f(m) = a + b*m + c*C(m,2) (m = column - s) is the
+        impulses G1[s] += a, G2[s+1] += b, G3[s+2] += c, and, so that f stops at e = s+L,
+        the continuation a + bL + cC(L,2) + (b + cL)m' + cC(m',2) (m' = column - e,
+        Vandermonde) subtracted at e, e+1, e+2. D = cumsum(G1 + cumsum(G2 + cumsum(G3))).
+        """
+        stride, width = self.stride, self.width
+        g = np.zeros((3, n_lines * stride), dtype=np.uint64)
+        if self.poly:
+            t = np.array(self.poly, dtype=np.int64)
+            base, n = t[:, 0], t[:, 1]
+            ua, ub, uc = (t[:, k].view(np.uint64) for k in (2, 3, 4))
+            nu = n.view(np.uint64)
+            tri = (nu * (nu - np.uint64(1))) >> np.uint64(1)  # C(L,2), exact: n < 2^32
+            end = base + n
+            np.add.at(g[0], base, ua)
+            np.add.at(g[1], base + 1, ub)
+            np.add.at(g[2], base + 2, uc)
+            np.add.at(g[0], end, (ua + ub * nu + uc * tri) * np.uint64(_U64))  # times -1
+            np.add.at(g[1], end + 1, (ub + uc * nu) * np.uint64(_U64))
+            np.add.at(g[2], end + 2, uc * np.uint64(_U64))
+        g = g.reshape(3, n_lines, stride)
+        d = np.cumsum(g[0] + np.cumsum(g[1] + np.cumsum(g[2], axis=1, dtype=np.uint64),
+                                       axis=1, dtype=np.uint64), axis=1, dtype=np.uint64)
+        flat = d.reshape(-1)
+        if self.expl:  # Acc_mode: only values with A >= 0 accumulate
+            t = np.array(self.expl, dtype=np.int64)
+            n = t[:, 1]
+            first = np.cumsum(n) - n
+            piece = np.repeat(np.arange(len(t)), n)
+            m = (np.arange(int(n.sum()), dtype=np.int64) - first[piece]).view(np.uint64)
+            u = t.view(np.uint64)
+            val = (u[piece, 2] + m * u[piece, 3]
+                   + ((m * (m - np.uint64(1))) >> np.uint64(1)) * u[piece, 4]) & MASK
+            ok = (val & SIGN) == 0
+            np.add.at(flat, (t[piece, 0] + m.view(np.int64))[ok], val[ok])
+        if self.over:  # Eval0: a locked D is the Eval0 intensity, whatever else ran
+            t = np.array(self.over, dtype=np.int64)
+            flat[t[:, 0]] = t[:, 1].view(np.uint64) << np.uint64(isa.FRAC_BITS)
+        d = d[:, :width] & MASK
+        return ((d >> np.uint64(isa.FRAC_BITS)) & np.uint64(isa.BLOCK_MASK)).astype(np.uint16)
+
+
+def _plannable(line) -> bool:
+    return all(c.order <= 2 for c in line)
+
+
+def _render_reference(commands, width: int = 640, carry_bug: bool = False) -> np.ndarray:
+    """`render` through the per-command path only (`run_line` on every line).
+
+    The reference the frame batch (`_Plan`) is tested against; slow.
+    """
+    lines = isa.split_lines(commands)
+    if lines and lines[-1][-1].op != "REFRESH":
+        lines.pop()
+    out = np.zeros((len(lines), width), dtype=np.uint16)
+    for i, ln in enumerate(lines):
+        out[i] = run_line(ln, width, carry_bug)[0]
+    return out
 
 
 def render(commands, width: int = 640, carry_bug: bool = False) -> np.ndarray:
@@ -337,9 +487,12 @@ def render(commands, width: int = 640, carry_bug: bool = False) -> np.ndarray:
                       stacklevel=2)
         lines.pop()
     out = np.zeros((len(lines), width), dtype=np.uint16)
-    fast = [] if carry_bug else [i for i, ln in enumerate(lines) if _batchable(ln)]
+    fast = [] if carry_bug else [i for i, ln in enumerate(lines) if _plannable(ln)]
     if fast:
-        out[fast] = _render_batch([lines[i] for i in fast], width)
+        plan = _Plan(width)
+        for row, i in enumerate(fast):
+            plan.line(row, lines[i])
+        out[fast] = plan.finish(len(fast))
     slow = sorted(set(range(len(lines))) - set(fast))
     for i in slow:
         out[i] = run_line(lines[i], width, carry_bug)[0]
