@@ -90,6 +90,16 @@ def patches() -> list[list[tuple[float, float, float]]]:
     return out
 
 
+def patch_flips() -> list[bool]:
+    """Per patch of patches(): True if it is mirrored in one axis only, which reverses
+    its orientation (its triangles must be wound the other way round to face out)."""
+    out = []
+    for k in range(len(PATCHES)):
+        signs = [(1, 1)] + ([(1, -1), (-1, 1), (-1, -1)] if k < FOUR_WAY else [(1, -1)])
+        out += [sx * sy < 0 for sx, sy in signs]
+    return out
+
+
 def _area2(a, b, c) -> float:
     u = [b[i] - a[i] for i in range(3)]
     v = [c[i] - a[i] for i in range(3)]
@@ -99,10 +109,16 @@ def _area2(a, b, c) -> float:
 
 def teapot_triangles(n: int):
     """(vertices, triangles): vertices in y-up world coordinates (x, z, -y of
-    Newell's), triangles as 0-based index triples; zero-area ones dropped."""
+    Newell's), triangles as 0-based index triples; zero-area ones dropped.
+
+    Vertices that coincide (patch seams, the mirrored halves, the poles) are welded
+    into one, so that smooth normals averaged over the faces sharing a vertex are
+    continuous across patch boundaries (the teapot's patches join with a common
+    tangent plane); unwelded, every seam shows as a shading crease."""
     verts, tris = [], []
-    for cp in patches():
-        base = len(verts)
+    index: dict = {}
+    for cp, flip in zip(patches(), patch_flips()):
+        grid = []
         for i in range(n + 1):
             bu = _bernstein(i / n)
             for j in range(n + 1):
@@ -113,13 +129,18 @@ def teapot_triangles(n: int):
                         w = bu[a] * bv[b]
                         q = cp[4 * a + b]
                         p[0] += w * q[0]; p[1] += w * q[1]; p[2] += w * q[2]
-                verts.append((p[0], p[2], -p[1]))
+                v = (p[0], p[2], -p[1])
+                key = tuple(round(x, 9) + 0.0 for x in v)     # + 0.0: -0 and 0 weld
+                if key not in index:
+                    index[key] = len(verts)
+                    verts.append(v)
+                grid.append(index[key])
         for i in range(n):
             for j in range(n):
-                a = base + i * (n + 1) + j
-                b, c, d = a + 1, a + n + 1, a + n + 2
-                for t in ((a, c, d), (a, d, b)):
-                    if _area2(verts[t[0]], verts[t[1]], verts[t[2]]) > 1e-12:
+                k = i * (n + 1) + j
+                a, b, c, d = grid[k], grid[k + 1], grid[k + n + 1], grid[k + n + 2]
+                for t in (((a, d, c), (a, b, d)) if flip else ((a, c, d), (a, d, b))):
+                    if len(set(t)) == 3 and _area2(verts[t[0]], verts[t[1]], verts[t[2]]) > 1e-12:
                         tris.append(t)
     return verts, tris
 
