@@ -15,7 +15,20 @@ that "piecewise linear on the 12-bit grid" survives storage.
   natural.png  grey, 1/f^1.8 filtered noise + soft shading: a "natural-like" image
   spheres.png  colour (RGB), Phong-shaded spheres on a graded floor: a rendered frame
 
-Usage: scripts/make_test_images.py [--out sw/images]
+640x480 (the display's width, for the real-time capacity figures):
+
+  natural640.png grey, the natural-like image's recipe at 640x480 (its own noise field)
+  teapot.png   colour, the project's own rendered Utah teapot frame (`scripts/demo.py
+               --no-rtl`: OBJ -> HSR -> y-processor -> golden model, 12-bit pixels
+               stored exactly); the most natural image the project can ship - smooth
+               Phong shading, anti-aliased silhouettes, a textured-free background
+  tiny_rgb.png colour 72x54: the teapot frame cropped to 576x432 and 8x8 box-averaged,
+               small enough to decode whole through a Verilated 8-chip array (tb/recon)
+
+The teapot images need the C y-processor (built by `make -C sw/hsr` on demand by
+demo.py, ~25 s); `--synthetic-only` skips them.
+
+Usage: scripts/make_test_images.py [--out sw/images] [--synthetic-only]
 """
 from __future__ import annotations
 
@@ -118,13 +131,40 @@ def _filtered_noise(rng, shape, beta=1.8):
     return (n - n.mean()) / n.std()
 
 
-def natural() -> np.ndarray:
-    rng = np.random.default_rng(42)
-    n = _filtered_noise(rng, (H, W))
-    yy, xx = np.mgrid[0:H, 0:W].astype(float)
-    shade = 0.6 * np.exp(-((xx - 170) ** 2 + (yy - 50) ** 2) / (2 * 60.0 ** 2))
-    img = 2048 + 650 * n + 900 * shade - 300 * (yy / H)
+def natural(h: int = H, w: int = W, seed: int = 42) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    n = _filtered_noise(rng, (h, w))
+    yy, xx = np.mgrid[0:h, 0:w].astype(float)
+    sx, sy = w / W, h / H
+    shade = 0.6 * np.exp(-((xx - 170 * sx) ** 2 / sx ** 2 + (yy - 50 * sy) ** 2 / sy ** 2)
+                         / (2 * 60.0 ** 2))
+    img = 2048 + 650 * n + 900 * shade - 300 * (yy / h)
     return img
+
+
+def natural640() -> np.ndarray:
+    return natural(480, 640, seed=640)
+
+
+def render_teapot() -> np.ndarray:
+    """The teapot frame of `scripts/demo.py --no-rtl` as 12-bit RGB (480, 640, 3)."""
+    import subprocess
+    import sys
+    import tempfile
+
+    root = Path(__file__).resolve().parents[1]
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([sys.executable, str(root / "scripts" / "demo.py"), "--no-rtl",
+                        "--out", tmp], check=True, stdout=subprocess.DEVNULL)
+        buf = oiio.ImageBuf(str(Path(tmp) / "demo.png"))
+        px = buf.get_pixels(oiio.UINT16)
+    v = (px.astype(np.int64) * MAXV + 32767) // 65535
+    return v[:, :, :3].astype(float)
+
+
+def tiny_rgb(teapot: np.ndarray) -> np.ndarray:
+    c = teapot[24:24 + 432, 32:32 + 576]
+    return c.reshape(54, 8, 72, 8, 3).mean(axis=(1, 3))
 
 
 def spheres() -> np.ndarray:
@@ -158,7 +198,7 @@ def spheres() -> np.ndarray:
 
 
 IMAGES = {"ramps": ramps, "zoneplate": zoneplate, "circles": circles, "bars": bars,
-          "natural": natural, "spheres": spheres}
+          "natural": natural, "spheres": spheres, "natural640": natural640}
 
 
 def write_png(path: Path, v12: np.ndarray) -> None:
@@ -174,12 +214,18 @@ def write_png(path: Path, v12: np.ndarray) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "sw" / "images"))
+    ap.add_argument("--synthetic-only", action="store_true", help="skip the teapot frames")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for name, fn in IMAGES.items():
         write_png(out / f"{name}.png", fn())
         print(f"wrote {out / (name + '.png')}")
+    if not args.synthetic_only:
+        tea = render_teapot()
+        for name, img in (("teapot", tea), ("tiny_rgb", tiny_rgb(tea))):
+            write_png(out / f"{name}.png", img)
+            print(f"wrote {out / (name + '.png')}")
     return 0
 
 

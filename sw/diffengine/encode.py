@@ -50,6 +50,10 @@ PIXEL_MAX = 4095
 BYTES_PER_SLOT = 6
 CHANNEL_SUFFIX = ("r", "g", "b")
 CODECS = ("spline2", "spline1", "rle", "raster")
+# knot forms (one Eval per line / per scale / cheaper per line) and per-coefficient forms
+# (one accumulated Eval per kept basis function / per function the cheaper of that and
+# its knots): encode_spline's module docstring
+EMISSIONS = ("auto", "merged", "layered", "coefficient", "choice")
 LAM_LO, LAM_HI = -1.0, 7.5   # log10 of the search range of lam
 
 
@@ -158,19 +162,31 @@ class ChannelEncoder:
 
     def __init__(self, x: np.ndarray, emission: str = "auto"):
         check_array(x)
+        if emission not in EMISSIONS:
+            raise EncodeError(f"unknown emission {emission!r} (one of {', '.join(EMISSIONS)})")
         self.x = np.asarray(x, dtype=np.int64)
         self.emission = emission
         self._coders: dict[int, ES.SplineCoder] = {}
 
+    @property
+    def basis(self) -> str:
+        """Encoding-time part of the emission: knots, or per-coefficient pieces."""
+        return self.emission if self.emission in ES.BASES else "knots"
+
+    @property
+    def line_mode(self) -> str:
+        """Emission of the per-line base Eval (per-coefficient modes: merged)."""
+        return "merged" if self.emission in ES.BASES else self.emission
+
     def coder(self, d: int) -> ES.SplineCoder:
         if d not in self._coders:
-            self._coders[d] = ES.SplineCoder(self.x, d)
+            self._coders[d] = ES.SplineCoder(self.x, d, basis=self.basis)
         return self._coders[d]
 
     # spline ------------------------------------------------------------------------------
     def spline_lam(self, d: int, lam: float) -> Result:
         progs = self.coder(d).encode(lam)
-        cmds = ES.frame_commands(progs, self.emission)
+        cmds = ES.frame_commands(progs, self.line_mode)
         return _result(f"spline{d}", cmds, self.x, lam, ES.frame_pixels(progs))
 
     def _spline_quick(self, d: int, lam: float) -> tuple[float, int, list]:
@@ -228,7 +244,7 @@ class ChannelEncoder:
         co = self.coder(d)
         with ES.single_thread_blas():
             progs = [co.encode_line_budget(r, per_line) for r in range(self.x.shape[0])]
-        cmds = ES.frame_commands(progs, self.emission)
+        cmds = ES.frame_commands(progs, self.line_mode)
         res = _result(f"spline{d}", cmds, self.x, float("nan"), ES.frame_pixels(progs))
         res.notes["fits"] = res.max_slots_per_line <= per_line
         return res
@@ -371,8 +387,11 @@ def encode_main(argv=None) -> int:
                    "Refresh included (800 = 640x480@60)")
     g.add_argument("--bytes", type=int, help="size target: bytes of the 48-bit stream")
     g.add_argument("--lossless", action="store_true", help="exact (the default target)")
-    ap.add_argument("--emission", default="auto", choices=("auto", "merged", "layered"),
-                    help="spline emission: one Eval per line, one per scale, or cheaper")
+    ap.add_argument("--emission", default="auto", choices=EMISSIONS,
+                    help="spline emission: one Eval per line (merged), one per scale "
+                    "(layered), the cheaper of the two per line (auto), one accumulated "
+                    "Eval per kept basis function (coefficient), or per basis function "
+                    "whichever of own Eval / knots is cheaper (choice)")
     ap.add_argument("--baselines", action="store_true",
                     help="also write OUT.raster.cmd, OUT.rle.cmd and OUT.jpg (matched bytes)")
     ap.add_argument("--preview", help="write the golden model's decoded image (16-bit PNG)")

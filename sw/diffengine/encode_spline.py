@@ -41,6 +41,18 @@ its kinks).
 Emission: `merged` (one Eval per line, all knots as Sets) or `layered` (one accumulated
 Eval per scale, each with its own Sets; the knot jumps of a scale are summed into D by
 the array, §7.7.2). Both give identical pixels; `auto` takes the cheaper per line.
+
+Per-coefficient emission (decided at encoding time, `SplineCoder(basis=...)`):
+`coefficient` sends every kept pyramid atom as its own accumulated Eval over its support
+(the wavelet synthesis sum of §7.7.2, done by D += A): the atom's coefficient is
+quantised to one integer multiplier q of its integer kernel (q * box_h^(d+1), exact in
+12.24, zero outside the span), evaluated at the lowest order that represents it (a
+unit impulse is one `Eval1`, 3 instructions), with Sets at its interior knots. One base
+Eval carries the least-squares polynomial of the residual and the +0.5 rounding offset.
+`choice` decides per kept atom: its own Eval if that costs fewer instructions than the
+knots it alone adds to the merged form (2 per knot not shared with another merged atom),
+otherwise its knots join the merged Eval, which is refitted (least squares) to what the
+own-Eval atoms leave. Patches as above in both.
 """
 from __future__ import annotations
 
@@ -104,6 +116,8 @@ class Level:
     pinv: np.ndarray       # (M, n)
     knots: np.ndarray      # (M, n) bool: knot incidence of each atom
     cost: np.ndarray       # (M,) instructions of the atom's knots (2 per knot)
+    ints: np.ndarray = None    # (n, M) int64: the integer kernels (atoms = ints / norms)
+    norms: np.ndarray = None   # (M,)
 
 
 def _knot_mask(col: np.ndarray, d: int) -> np.ndarray:
@@ -135,11 +149,14 @@ def pyramid(n: int, d: int, levels: int) -> tuple[Level, ...]:
         keep = atoms_i.any(axis=0)
         atoms_i = atoms_i[:, keep]
         knots = np.array([_knot_mask(atoms_i[:, i], d) for i in range(atoms_i.shape[1])])
-        atoms = atoms_i / np.linalg.norm(atoms_i, axis=0)
-        out.append(Level(h, atoms, np.linalg.pinv(atoms), knots, 2 * knots.sum(axis=1)))
+        norms = np.linalg.norm(atoms_i, axis=0)
+        atoms = atoms_i / norms
+        out.append(Level(h, atoms, np.linalg.pinv(atoms), knots, 2 * knots.sum(axis=1),
+                         atoms_i, norms))
     eye = np.eye(n)
     knots = np.array([_knot_mask(eye[:, i], d) for i in range(n)])
-    out.append(Level(1, eye, eye, knots, np.maximum(2 * knots.sum(axis=1), 1)))
+    out.append(Level(1, eye, eye, knots, np.maximum(2 * knots.sum(axis=1), 1),
+                     np.eye(n, dtype=np.int64), np.ones(n)))
     return tuple(out)
 
 
@@ -215,9 +232,22 @@ class LineProgram:
     knots: list[tuple[int, int]]         # (k, Δ^d value from k on), 12.24 units
     labels: dict[int, int] = field(default_factory=dict)  # knot -> pyramid level index
     patches: list[tuple[int, int, int]] = field(default_factory=list)  # (x, dx, pixel)
+    # accumulated Evals of single basis functions (per-coefficient emission): (x, program)
+    pieces: list[tuple[int, "LineProgram"]] = field(default_factory=list)
+
+    def cost(self) -> int:
+        """Instructions of this program as one Eval with its Sets (no patches, pieces)."""
+        return self.d + 3 + 2 * len(self.knots)
+
+    def spline_raw(self) -> np.ndarray:
+        """Exact D values of the base Eval plus every piece (int64, not reduced)."""
+        s = self.raw()
+        for x0, sp in self.pieces:
+            s[x0:x0 + sp.n] += sp.raw()
+        return s
 
     def raw(self) -> np.ndarray:
-        """Exact D values (int64, not yet reduced mod 2^36) of the spline part."""
+        """Exact D values (int64, not yet reduced mod 2^36) of the base Eval alone."""
         top = np.zeros(self.n, dtype=np.int64)     # Δ^d s(m)
         top[:] = self.init[self.d]
         for k, g in self.knots:
@@ -228,7 +258,7 @@ class LineProgram:
         return s
 
     def pixels(self) -> np.ndarray:
-        p = ((self.raw() & isa.WORD_MASK) >> isa.FRAC_BITS).astype(np.int64) & isa.BLOCK_MASK
+        p = ((self.spline_raw() & isa.WORD_MASK) >> isa.FRAC_BITS).astype(np.int64) & isa.BLOCK_MASK
         for x, dx, v in self.patches:
             p[x:x + dx] = v
         return p
@@ -285,6 +315,27 @@ def quantise(s: np.ndarray, knots, d: int) -> LineProgram:
     return LineProgram(n, d, [_sig(v) for v in init], out_knots)
 
 
+def exact_program(v: np.ndarray, dmax: int) -> LineProgram:
+    """The cheapest exact Eval (order 0..dmax, with Sets of its top difference) for the
+    integer 12.24 sequence v; its raw() equals v."""
+    v = np.asarray(v, dtype=np.int64)
+    n = len(v)
+    best = None
+    for p in range(0, dmax + 1):
+        if p > 0 and n < p + 1:
+            break
+        top = np.diff(v, p)
+        if p == 0 and np.any(top != top[0]):
+            continue
+        init = [int(np.diff(v, j)[0]) for j in range(p + 1)]
+        ch = np.flatnonzero(top[1:] != top[:-1]) + 1
+        knots = [(int(k), int(top[k])) for k in ch]
+        prog = LineProgram(n, p, init, knots)
+        if best is None or prog.cost() < best.cost():
+            best = prog
+    return best
+
+
 # ---- emission ---------------------------------------------------------------------------
 
 
@@ -323,6 +374,17 @@ def _layered(p: LineProgram) -> list[Command]:
     return cmds
 
 
+def _pieces(p: LineProgram) -> list[Command]:
+    """One accumulated Eval per piece, each right after its own Sets (a Set waits for the
+    next Eval active in its PE, so it must not precede an earlier piece's Eval there)."""
+    cmds = []
+    for x0, sp in p.pieces:
+        if sp.d:
+            cmds += [Command(SET_OP[sp.d], x0 + k, 1, (_sig(g),)) for k, g in sp.knots]
+        cmds.append(Command("EVAL", x0, sp.n, tuple(_sig(v) for v in sp.init)))
+    return cmds
+
+
 def slot_count(cmds) -> int:
     return sum(len(isa.slots(c)) for c in cmds)
 
@@ -338,13 +400,14 @@ def emit(p: LineProgram, mode: str = "auto") -> list[Command]:
         body = a if slot_count(a) <= slot_count(b) else b
     else:
         raise ValueError(f"unknown emission mode {mode!r}")
+    body += _pieces(p)
     body += [Command("EVAL0", x, dx, (v,)) for x, dx, v in p.patches]
     return body + [Command("REFRESH")]
 
 
 def line_cost(p: LineProgram) -> int:
-    """Instructions of the merged form (what `auto` never exceeds)."""
-    return p.d + 3 + 2 * len(p.knots) + len(p.patches) + 1
+    """Instructions of the merged form (what `auto` never exceeds), pieces included."""
+    return (p.cost() + sum(sp.cost() for _, sp in p.pieces) + len(p.patches) + 1)
 
 
 # ---- encoding ----------------------------------------------------------------------------
@@ -368,12 +431,23 @@ def _patch(p: LineProgram, target: np.ndarray, lam: float) -> None:
             i += 1
 
 
-class SplineCoder:
-    """Encoder for one channel (rows, n) of 12-bit targets at degree d (1 or 2)."""
+BASES = ("knots", "coefficient", "choice")
 
-    def __init__(self, target: np.ndarray, d: int = 2, levels: int | None = None):
+
+class SplineCoder:
+    """Encoder for one channel (rows, n) of 12-bit targets at degree d (1 or 2).
+
+    basis: `knots` (every kept atom contributes knots to one refitted Eval per line),
+    `coefficient` (every kept atom its own accumulated Eval) or `choice` (per atom, the
+    cheaper of the two); see the module docstring."""
+
+    def __init__(self, target: np.ndarray, d: int = 2, levels: int | None = None,
+                 basis: str = "knots"):
         if d not in (1, 2):
             raise ValueError("spline degree must be 1 (Eval2 + SetdI) or 2 (Eval3 + SetddI)")
+        if basis not in BASES:
+            raise ValueError(f"unknown basis {basis!r} (one of {', '.join(BASES)})")
+        self.basis = basis
         self.x = np.asarray(target, dtype=np.int64)
         self.d = d
         n = self.x.shape[1]
@@ -394,8 +468,51 @@ class SplineCoder:
                 mask |= km
         return np.flatnonzero(mask), labels
 
+    def encode_line_pieces(self, row: int, lam: float) -> LineProgram:
+        """Per-coefficient emission: kept atoms as accumulated Evals (basis `coefficient`),
+        or per atom whichever is cheaper, own Eval or knots in the merged Eval (`choice`)."""
+        x = self.x[row]
+        n, d = len(x), self.d
+        atoms = []   # (knot mask, start, piece program)
+        for lev, c in zip(self.pyr, self.coefs):
+            for i in np.flatnonzero(c[row] ** 2 >= lam * lev.cost):
+                q = int(round(float(c[row, i]) / lev.norms[i] * ONE))
+                if q == 0:
+                    continue
+                ker = lev.ints[:, i]
+                nz = np.flatnonzero(ker)
+                a, b = int(nz[0]), int(nz[-1]) + 1
+                atoms.append((lev.knots[i], a, exact_program(q * ker[a:b], d)))
+        own = [True] * len(atoms)
+        cnt = np.zeros(n, dtype=np.int64)
+        if self.basis == "choice":
+            own = [False] * len(atoms)
+            for km, _, _ in atoms:
+                cnt += km
+            changed = True
+            while changed:
+                changed = False
+                for j, (km, _, sp) in enumerate(atoms):
+                    if not own[j] and sp.cost() < 2 * int(np.count_nonzero(km & (cnt == 1))):
+                        own[j] = True
+                        cnt -= km
+                        changed = True
+        pieces = [(a, sp) for (km, a, sp), o in zip(atoms, own) if o]
+        resid = x.astype(float)
+        for a, sp in pieces:
+            resid[a:a + sp.n] -= sp.raw() / ONE
+        knots = np.flatnonzero(cnt > 0)
+        s = fit(resid, knots, d) if len(knots) < n - d - 1 else resid
+        p = quantise(s, knots, d)
+        p.labels = {int(k): 0 for k in knots}
+        p.pieces = pieces
+        _patch(p, x, lam)
+        return p
+
     def encode_line(self, row: int, lam: float) -> LineProgram:
         x = self.x[row]
+        if self.basis != "knots":
+            return self.encode_line_pieces(row, lam)
         if lam <= 0:
             knots = np.flatnonzero(_knot_mask(x, self.d))
             p = quantise(x.astype(float), knots, self.d)

@@ -40,10 +40,42 @@ def test_all_coefficients_kept_natural_psnr_50(natural, d):
     assert ES.psnr(dec, natural) >= 50.0
 
 
+@pytest.fixture(scope="module")
+def teapot():
+    # the project's rendered teapot frame (scripts/make_test_images.py -> demo.py): the
+    # most natural image it can ship (smooth Phong shading, anti-aliased silhouettes)
+    return EN.load_image(IMAGES / "teapot.png")
+
+
+@pytest.mark.parametrize("d,basis,rows", [(2, "knots", slice(0, 480)),
+                                          (1, "knots", slice(96, 240)),
+                                          (2, "coefficient", slice(150, 166)),
+                                          (1, "coefficient", slice(150, 166))])
+def test_all_coefficients_kept_teapot_psnr_50(teapot, d, basis, rows):
+    """Round trip with every pyramid coefficient kept, no Eval0 patch, on the rendered
+    640x480 teapot frame (all three channels; whole frame for spline2 knots)."""
+    for c in range(3):
+        x = teapot[rows, :, c]
+        progs = ES.SplineCoder(x, d, basis=basis).encode(1e-9)
+        for p in progs:
+            p.patches = []
+        cmds = ES.frame_commands(progs, "merged")
+        assert not any(c.op == "EVAL0" for c in cmds)
+        dec = functional.render(cmds, x.shape[1])
+        assert ES.psnr(dec, x) >= 50.0, (basis, d, c)
+
+
 @pytest.mark.parametrize("d", [1, 2])
-@pytest.mark.parametrize("mode", ["merged", "layered"])
+@pytest.mark.parametrize("mode", ["merged", "layered", "coefficient", "choice"])
 def test_lossless_exact_on_piecewise_linear(d, mode):
     x = crop("ramps", rows=16, cols=256, c0=0)
+    if mode in ES.BASES:
+        progs = ES.SplineCoder(x, d, basis=mode).encode(0.0)
+        cmds = ES.frame_commands(progs, "merged")
+        # every basis function is kept: the per-coefficient forms cost far more (below)
+        dec = functional.render(cmds, x.shape[1]).astype(np.int64)
+        assert np.array_equal(dec, x)
+        return
     co = ES.SplineCoder(x, d)
     progs = co.encode(0.0)
     assert all(not p.patches for p in progs)
@@ -102,6 +134,75 @@ def test_merged_and_layered_identical(natural):
     b = functional.render(ES.frame_commands(progs, "layered"), natural.shape[1])
     assert np.array_equal(a, b)
     assert np.array_equal(a.astype(np.int64), ES.frame_pixels(progs))
+
+
+@pytest.mark.parametrize("d", [1, 2])
+def test_emission_modes_identical_where_lossless(natural, d):
+    """Every emission mode decodes the lossless code to the image itself."""
+    for name, x in (("natural", natural[:8]), ("circles", crop("circles", rows=8))):
+        for em in EN.EMISSIONS:
+            res = EN.ChannelEncoder(x, em).encode(f"spline{d}", lossless=True)
+            assert np.array_equal(res.pixels, x), (name, em)
+            ok, path = EN.rtl_bit_identity(res.commands, x.shape[1]) if name == "circles" \
+                else (True, "")
+            assert ok, (name, em, path)
+
+
+@pytest.mark.parametrize("basis", ["coefficient", "choice"])
+def test_per_coefficient_slot_counts(natural, basis):
+    """Slot counts as claimed: a piece of order p with s Sets costs p + 3 + 2 s, the line
+    costs base Eval + Sets + pieces + patches + Refresh, and the golden model decodes the
+    commands to the encoder's own integer simulation (lossy lam)."""
+    x = natural[:6]
+    co = ES.SplineCoder(x, 2, basis=basis)
+    progs = co.encode(300.0)
+    for p in progs:
+        cmds = ES.emit(p, "merged")
+        assert ES.slot_count(cmds) == ES.line_cost(p)
+        assert sum(c.op == "EVAL" for c in cmds) == 1 + len(p.pieces)
+        for x0, sp in p.pieces:
+            assert sp.cost() == sp.d + 3 + 2 * len(sp.knots) and 0 <= sp.d <= 2
+            assert 0 <= x0 and x0 + sp.n <= x.shape[1]
+    cmds = ES.frame_commands(progs, "merged")
+    dec = functional.render(cmds, x.shape[1]).astype(np.int64)
+    assert np.array_equal(dec, ES.frame_pixels(progs))
+    ok, path = EN.rtl_bit_identity(cmds, x.shape[1])
+    assert ok, path
+    if basis == "coefficient":  # one accumulated Eval per kept atom with q != 0
+        kept = 0
+        for lev, c in zip(co.pyr, co.coefs):
+            sel = c[0] ** 2 >= 300.0 * lev.cost
+            kept += int(np.count_nonzero(np.rint(c[0][sel] / lev.norms[sel] * ES.ONE)))
+        assert len(progs[0].pieces) == kept
+
+
+@pytest.mark.parametrize("d", [1, 2])
+def test_choice_takes_the_cheaper_form_per_function(d):
+    """Isolated impulses: as knots an impulse costs 2(d+2) instructions, as its own
+    accumulated Eval1 (one column) 3; `choice` sends each as an Eval, `knots` as knots.
+    The pixels are the same, and the smooth part stays in the merged Eval."""
+    n, spikes = 96, [20, 45, 70]
+    x = np.zeros((1, n), dtype=np.int64)
+    x[0, spikes] = [900, 1500, 600]
+    knots = ES.SplineCoder(x, d, levels=0).encode(1.0)
+    choice = ES.SplineCoder(x, d, levels=0, basis="choice").encode(1.0)
+    assert not knots[0].patches and not choice[0].patches
+    assert len(choice[0].pieces) == 3 and all(sp.d == 0 and sp.cost() == 3
+                                              for _, sp in choice[0].pieces)
+    assert ES.line_cost(knots[0]) == d + 3 + 2 * (d + 2) * 3 + 1
+    assert ES.line_cost(choice[0]) == d + 3 + 3 * 3 + 1
+    a = functional.render(ES.frame_commands(knots, "merged"), n).astype(np.int64)
+    b = functional.render(ES.frame_commands(choice, "merged"), n).astype(np.int64)
+    assert np.array_equal(a, x) and np.array_equal(b, x)
+
+
+def test_choice_never_dearer_than_coefficient(natural):
+    for lam in (30.0, 3000.0):
+        s = {}
+        for basis in ("coefficient", "choice"):
+            progs = ES.SplineCoder(natural[:6], 2, basis=basis).encode(lam)
+            s[basis] = sum(ES.line_cost(p) - len(p.patches) for p in progs)
+        assert s["choice"] <= s["coefficient"], (lam, s)
 
 
 def test_large_differences_wrap_not_clip():
