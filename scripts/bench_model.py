@@ -2,9 +2,12 @@
 """Benchmark the functional golden model on random but realistic 640x480 frames.
 
 Two frames, ~100 commands per line, spans of 5-60 px at random X:
-  * "eval-only": Eval1/2/3 (20/40/40 %) - every line takes the batched frame path;
-  * "mixed": the same plus, per line, about 3 Set/SetP/Dis/Eval0 commands - every
-    line then takes the per-command path.
+  * "eval-only": Eval1/2/3 (20/40/40 %);
+  * "mixed": the same plus, per line, about 3 Set/SetP/Dis/Eval0 commands.
+Both take the batched frame path of `functional.render`. For comparison, the mixed frame
+also goes once through the per-command path (`functional._render_reference`, what every
+line with a Set/Dis/Eval0 took before the batch covered them), and the first lines of it
+through the cycle-level structural model (the baseline).
 Prints commands/s and seconds/frame (best of --repeat) and, with --write, updates the
 "Golden model (functional)" section of docs/performance.md (other sections untouched).
 """
@@ -55,11 +58,11 @@ def random_frame(rng, width=640, height=480, per_line=100, mixed=False):
     return cmds
 
 
-def bench(cmds, repeat):
+def bench(cmds, repeat, fn=functional.render):
     best = float("inf")
     for _ in range(repeat):
         t = time.perf_counter()
-        functional.render(cmds)
+        fn(cmds)
         best = min(best, time.perf_counter() - t)
     return best
 
@@ -76,6 +79,12 @@ def main(argv=None):
         sec = bench(cmds, args.repeat)
         rows.append((name, len(cmds), sec, len(cmds) / sec))
         print(f"{name:10s} {len(cmds):7d} commands  {sec:7.3f} s/frame  {len(cmds) / sec:12,.0f} commands/s")
+    sec = bench(cmds, 1, functional._render_reference)  # slow: once is enough
+    if not np.array_equal(functional.render(cmds), functional._render_reference(cmds)):
+        sys.exit("mixed frame: the batched path and the per-command path disagree")
+    rows.append(("mixed, per-command path (`_render_reference`, once)", len(cmds), sec,
+                 len(cmds) / sec))
+    print(f"per-cmd    {len(cmds):7d} commands  {sec:7.3f} s/frame  {len(cmds) / sec:12,.0f} commands/s")
     # Baseline in the same run (these machines are noisy): the cycle-level structural
     # model on the first lines of the mixed frame, extrapolated to a whole frame.
     lines = isa.split_lines(random_frame(np.random.default_rng(args.seed), mixed=True))[:4]
@@ -88,10 +97,10 @@ def main(argv=None):
                  n_frame / (sec_line * 480)))
     print(f"baseline   structural model {sec_line * 480:7.1f} s/frame (extrapolated from 4 lines)")
     if args.write:
-        write_doc(rows)
+        write_doc(rows, args.repeat)
 
 
-def write_doc(rows):
+def write_doc(rows, repeat):
     path = ROOT / "docs" / "performance.md"
     text = path.read_text() if path.exists() else "# Performance\n"
     base = rows[-1][2]
@@ -99,10 +108,15 @@ def write_doc(rows):
     body = f"""{SECTION}
 
 `functional.render()` on a random 640x480 frame, ~100 commands per line (Eval1/2/3 spans
-of 5-60 px; "mixed" adds ~3 Set/SetP/Dis/Eval0 per line, which sends every line through
-the per-command path instead of the batched Eval1-3 frame path). The baseline, measured in
-the same run, is the cycle-level structural model on the mixed frame. Best of 3, one core,
-{platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}, {platform.machine()}.
+of 5-60 px; "mixed" adds ~3 Set/SetP/Dis/Eval0 per line). Both frames take the batched
+frame path (`functional._Plan`: a scalar walk of each line turns its Evals into polynomial
+pieces, cut at protect flags and split around disabled columns, and difference arrays sum
+them for the whole frame); only lines with Eval4+ or the carry bug go command by command.
+For comparison, the mixed frame through the per-command path (`run_line` on every line,
+`functional._render_reference`), which such lines took before; the batch is tested
+against it (`sw/tests/test_functional_batch.py`). The baseline, measured in the same run,
+is the cycle-level structural model on the mixed frame. Best of {repeat} (per-command path:
+once), one core, {platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}, {platform.machine()}.
 
 | frame | commands | s/frame | commands/s | speed vs baseline |
 |---|---|---|---|---|

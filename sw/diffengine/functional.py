@@ -304,37 +304,48 @@ class _Plan:
     def __init__(self, width: int):
         self.width = width
         self.stride = width + 3
-        self.poly: list[tuple[int, int, int, int, int]] = []  # flat start, n, v0, v1, v2
-        self.expl: list[tuple[int, int, int, int, int]] = []  # the same, Acc_mode on
+        # pieces by order k = 0..2, flat: row offset, X, dX (clipped later), v_0 .. v_k
+        self.poly: list[list[int]] = [[], [], []]
+        self.expl: list[tuple[int, int, int, int, int]] = []  # flat start, n, v0-v2: Acc_mode
         self.over: list[tuple[int, int]] = []  # flat column, Eval0 intensity
+        self.rows = 0
 
-    def line(self, row: int, cmds) -> None:
+    def line(self, cmds) -> bool:
+        """Plan one line as the next row; False (and nothing planned) if it has Eval4+."""
         w = self.width
-        base = row * self.stride
+        base = self.rows * self.stride
         poly, expl = self.poly, self.expl
+        undo = [len(t) for t in poly], len(expl)
+        poly2 = poly[2]
         pv: list[dict[int, int]] = [{}, {}, {}]  # A, B, C: column -> Set value
         pk: list[list[int]] = [[], [], []]  # sorted keys of pv
         dis: set[int] = set()
         dk: list[int] = []
         lock: dict[int, int] = {}
         acc = False
+        quiet = True  # no flag raised, Acc_mode off: an Eval is one piece, as written
         for c in cmds:
             op = c.op
             if op == "EVAL":
+                vals = c.values
+                p = len(vals) - 1
+                if p > 2:
+                    for t, n in zip(poly, undo[0]):
+                        del t[n:]
+                    del expl[undo[1]:]
+                    return False
+                if quiet:  # the common case
+                    poly[p].extend((base, c.x, c.dx) + vals)
+                    continue
                 a = c.x if c.x < w else w
                 e = c.x + c.dx
                 if e > w:
                     e = w
                 if e <= a:
                     continue
-                vals = c.values
-                p = len(vals) - 1
                 v0 = vals[0] & _W
                 v1 = vals[1] & _W if p >= 1 else 0
                 v2 = vals[2] & _W if p >= 2 else 0
-                if not (pk[0] or pk[1] or pk[2] or dk or acc):  # the common case
-                    poly.append((base + a, e - a, v0, v1, v2))
-                    continue
                 cuts = {a}
                 for r in range(p + 1):
                     ks = pk[r]
@@ -344,7 +355,6 @@ class _Plan:
                             cuts.update(ks[i:j])
                 cuts = sorted(cuts)
                 cuts.append(e)
-                out = expl if acc else poly
                 for k in range(len(cuts) - 1):
                     s, t = cuts[k], cuts[k + 1]
                     if s in pv[0]:  # protect flags substitute the incoming differences
@@ -358,12 +368,19 @@ class _Plan:
                         i, j = bisect_left(dk, s), bisect_left(dk, t)
                         for col in dk[i:j]:
                             if col > q:
-                                out.append((base + q, col - q, *_advance(v0, v1, v2, q - s)))
+                                if acc:
+                                    expl.append((base + q, col - q, *_advance(v0, v1, v2, q - s)))
+                                else:
+                                    poly2.extend((base, q, col - q, *_advance(v0, v1, v2, q - s)))
                             q = col + 1
                     if t > q:
-                        out.append((base + q, t - q, *_advance(v0, v1, v2, q - s)))
+                        if acc:
+                            expl.append((base + q, t - q, *_advance(v0, v1, v2, q - s)))
+                        else:
+                            poly2.extend((base, q, t - q, *_advance(v0, v1, v2, q - s)))
                     v0, v1, v2 = _advance(v0, v1, v2, t - s)
                 self._clear(a, e, pv, pk, dis, dk)
+                quiet = not (pk[0] or pk[1] or pk[2] or dk or acc)
             elif op in ("SETI", "SETDI", "SETDDI", "SETPI", "SETPDI", "SETPDDI"):
                 r = isa.SET_REG[op] - isa.REG_A
                 if op.startswith("SETP"):
@@ -373,11 +390,13 @@ class _Plan:
                 if cols:
                     pv[r].update(dict.fromkeys(cols, c.values[0] & _W))
                     pk[r] = sorted(pv[r])
+                    quiet = False
             elif op == "DIS":
                 cols = range(min(c.x, w), min(c.x + c.dx, w))
                 if cols:
                     dis.update(cols)
                     dk = sorted(dis)
+                    quiet = False
             elif op == "EVAL0":
                 a, e = min(c.x, w), min(c.x + c.dx, w)
                 if e <= a:
@@ -386,13 +405,17 @@ class _Plan:
                     if col not in lock and col not in dis:
                         lock[col] = c.values[0]
                 dk = self._clear(a, e, pv, pk, dis, dk)
+                quiet = not (pk[0] or pk[1] or pk[2] or dk or acc)
             elif op == "ACCMODE":
                 acc = bool(c.values[0])
+                quiet = not (pk[0] or pk[1] or pk[2] or dk or acc)
             elif op == "NOP" or op == "REFRESH":
                 pass
             else:
                 raise ValueError(f"unknown command {op!r}")
         self.over.extend((base + col, i) for col, i in lock.items())
+        self.rows += 1
+        return True
 
     @staticmethod
     def _clear(a, e, pv, pk, dis, dk):
@@ -412,7 +435,7 @@ class _Plan:
                 del dk[i:j]
         return dk
 
-    def finish(self, n_lines: int) -> np.ndarray:
+    def finish(self) -> np.ndarray:
         """Pixels of every planned line.
 
         A piece at s of length L adding f(m) = a + b*m + c*C(m,2) (m = column - s) is the
@@ -420,12 +443,23 @@ class _Plan:
         the continuation a + bL + cC(L,2) + (b + cL)m' + cC(m',2) (m' = column - e,
         Vandermonde) subtracted at e, e+1, e+2. D = cumsum(G1 + cumsum(G2 + cumsum(G3))).
         """
-        stride, width = self.stride, self.width
+        stride, width, n_lines = self.stride, self.width, self.rows
         g = np.zeros((3, n_lines * stride), dtype=np.uint64)
-        if self.poly:
-            t = np.array(self.poly, dtype=np.int64)
-            base, n = t[:, 0], t[:, 1]
-            ua, ub, uc = (t[:, k].view(np.uint64) for k in (2, 3, 4))
+        t = np.zeros((sum(len(q) // (k + 4) for k, q in enumerate(self.poly)), 6), np.int64)
+        i = 0
+        for k, q in enumerate(self.poly):
+            rec = np.array(q, dtype=np.int64).reshape(-1, k + 4)
+            t[i:i + len(rec), :k + 4] = rec
+            i += len(rec)
+        # clip [X, X+dX) to the array (pieces of the flag path already are)
+        x = np.minimum(t[:, 1], width)
+        n = np.minimum(t[:, 1] + t[:, 2], width) - x
+        t = t[n > 0]
+        if len(t):
+            base = t[:, 0] + x[n > 0]
+            n = n[n > 0]
+            # signed or 36-bit values -> uint64 (mod 2^64 is a multiple of mod 2^36)
+            ua, ub, uc = (t[:, k].view(np.uint64) for k in (3, 4, 5))
             nu = n.view(np.uint64)
             tri = (nu * (nu - np.uint64(1))) >> np.uint64(1)  # C(L,2), exact: n < 2^32
             end = base + n
@@ -457,10 +491,6 @@ class _Plan:
         return ((d >> np.uint64(isa.FRAC_BITS)) & np.uint64(isa.BLOCK_MASK)).astype(np.uint16)
 
 
-def _plannable(line) -> bool:
-    return all(c.order <= 2 for c in line)
-
-
 def _render_reference(commands, width: int = 640, carry_bug: bool = False) -> np.ndarray:
     """`render` through the per-command path only (`run_line` on every line).
 
@@ -487,12 +517,10 @@ def render(commands, width: int = 640, carry_bug: bool = False) -> np.ndarray:
                       stacklevel=2)
         lines.pop()
     out = np.zeros((len(lines), width), dtype=np.uint16)
-    fast = [] if carry_bug else [i for i, ln in enumerate(lines) if _plannable(ln)]
+    plan = _Plan(width)
+    fast = [] if carry_bug else [i for i, ln in enumerate(lines) if plan.line(ln)]
     if fast:
-        plan = _Plan(width)
-        for row, i in enumerate(fast):
-            plan.line(row, lines[i])
-        out[fast] = plan.finish(len(fast))
+        out[fast] = plan.finish()
     slow = sorted(set(range(len(lines))) - set(fast))
     for i in slow:
         out[i] = run_line(lines[i], width, carry_bug)[0]
