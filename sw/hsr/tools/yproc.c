@@ -1,6 +1,8 @@
 /* yproc - command-line front end of sw/hsr.
  *   yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]
- *                   [--svg FILE.svg] [--stats]
+ *                   [--svg FILE.svg] [--stats] [--ops FILE] [--rebuild]
+ * (--ops: incremental operations after the build, yproc_ops.c; --rebuild:
+ *  then a full hsr_rebuild of the resulting MLR, for comparison)
  *   yproc scan SCENE -o OUTDIR [--mode M] [--no-aa] [--shading S] [--frames N]
  *                    [--cmd] [--tol T] [--capacity N] [--expect]
  *   yproc anim ANIMSCENE -o OUTDIR [scan options] [--full]
@@ -16,11 +18,13 @@
 #include "hsr.h"
 
 int yproc_scan_main(int argc, char **argv);   /* yproc_scan.c part below */
+int yproc_apply_ops(hsr_ctx *h, const char *path, double **shade);   /* yproc_ops.c */
 
 static int usage(void)
 {
     fprintf(stderr, "usage: yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]"
                     " [--svg FILE.svg] [--stats]\n"
+                    "                 [--ops FILE] [--rebuild]\n"
                     "       yproc scan SCENE -o OUTDIR [--mode 640x480|640x485|1280x1024] [--no-aa]\n"
                     "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
                     "                  [--capacity SLOTS] [--expect]\n"
@@ -39,15 +43,15 @@ static hsr_status write_input_json(const char *path, const hsr_ctx *h, const hsr
     hsr_status st = HSR_OK;
     fprintf(f, "{\"format\": \"hsr-input-1\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
                " \"mlr_count\": %d, \"polygons\": [", HSR_SUBPIXEL, sc->width, sc->height, hsr_mlr_slots(h));
-    for (int id = 0; id < hsr_mlr_slots(h) && st == HSR_OK; id++) {
+    for (int id = 0, first = 1; id < hsr_mlr_slots(h) && st == HSR_OK; id++) {
         const hsr_domain *d; hsr_plane pl; double op;
-        if (!hsr_mlr_get(h, id, &d, &pl, &op, NULL, NULL)) continue;
+        if (!hsr_mlr_get(h, id, &d, &pl, &op, NULL, NULL)) continue;   /* removed (--ops) */
         double *xy = NULL; int *len = NULL, nr = 0;
         st = hsr_domain_rings(d, &xy, &len, &nr);
         if (st != HSR_OK) break;
         fprintf(f, "%s\n  {\"id\": %d, \"opacity\": %.17g, \"area_px2\": %.17g,"
                    " \"plane\": [%.17g, %.17g, %.17g],\n   \"rings\": [",
-                id ? "," : "", id, op, hsr_domain_area(d) / (S * S), pl.a * S, pl.b * S, pl.c);
+                first ? "" : ",", id, op, hsr_domain_area(d) / (S * S), pl.a * S, pl.b * S, pl.c);
         for (int r = 0, off = 0; r < nr; off += len[r], r++) {
             fprintf(f, "%s[", r ? ", " : "");
             for (int i = 0; i < len[r]; i++)
@@ -56,6 +60,7 @@ static hsr_status write_input_json(const char *path, const hsr_ctx *h, const hsr
         }
         fprintf(f, "]}");
         free(xy); free(len);
+        first = 0;
     }
     fprintf(f, "\n]}\n");
     if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
@@ -69,13 +74,15 @@ int main(int argc, char **argv)
         return rc == 2 ? usage() : rc;
     }
     if (argc < 3 || strcmp(argv[1], "hsr")) return usage();
-    const char *scene = argv[2], *json = NULL, *svg = NULL, *input = NULL;
-    int stats = 0;
+    const char *scene = argv[2], *json = NULL, *svg = NULL, *input = NULL, *ops = NULL;
+    int stats = 0, rebuild = 0;
     for (int i = 3; i < argc; i++) {
         if (!strcmp(argv[i], "--dump-llr") && i + 1 < argc) json = argv[++i];
         else if (!strcmp(argv[i], "--dump-input") && i + 1 < argc) input = argv[++i];
         else if (!strcmp(argv[i], "--svg") && i + 1 < argc) svg = argv[++i];
         else if (!strcmp(argv[i], "--stats")) stats = 1;
+        else if (!strcmp(argv[i], "--ops") && i + 1 < argc) ops = argv[++i];
+        else if (!strcmp(argv[i], "--rebuild")) rebuild = 1;
         else return usage();
     }
     char err[1024] = "";
@@ -90,7 +97,15 @@ int main(int argc, char **argv)
         hsr_scene_free(sc);
         return 1;
     }
-    int rc = 0;
+    int rc = ops ? yproc_apply_ops(h, ops, &shade) : 0;
+    if (!rc && rebuild && (st = hsr_rebuild(h)) != HSR_OK) {
+        fprintf(stderr, "%s: rebuild failed (%s)\n", scene, hsr_status_str(st)); rc = 1;
+    }
+    if (!rc && (ops || rebuild) && (st = hsr_check(h)) != HSR_OK) {
+        fprintf(stderr, "%s: inconsistent LLR/MLR administration after the operations (%s)\n",
+                ops ? ops : scene, hsr_status_str(st)); rc = 1;
+    }
+    if (rc) { free(shade); hsr_destroy(h); hsr_scene_free(sc); return rc; }
     if (json && (st = hsr_write_llr_json(json, h, sc)) != HSR_OK) {
         fprintf(stderr, "%s: cannot write (%s)\n", json, hsr_status_str(st)); rc = 1;
     }
