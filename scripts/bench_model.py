@@ -111,10 +111,11 @@ def write_doc(rows, repeat):
 of 5-60 px; "mixed" adds ~3 Set/SetP/Dis/Eval0 per line). Both frames take the batched
 frame path (`functional._Plan`: a scalar walk of each line turns its Evals into polynomial
 pieces, cut at protect flags and split around disabled columns, and difference arrays sum
-them for the whole frame); only lines with Eval4+ or the carry bug go command by command.
-For comparison, the mixed frame through the per-command path (`run_line` on every line,
-`functional._render_reference`), which such lines took before; the batch is tested
-against it (`sw/tests/test_functional_batch.py`). The baseline, measured in the same run,
+them for the whole frame); only the carry-bug option goes command by command.
+For comparison, the mixed frame also goes through the per-command path (`run_line` on
+every line, `functional._render_reference`), which lines with a Set/Dis/Eval0 took before
+the batch covered them; the batch is tested against it (`sw/tests/test_functional_batch.py`)
+and checked equal to it here. The baseline, measured in the same run,
 is the cycle-level structural model on the mixed frame. Best of {repeat} (per-command path:
 once), one core, {platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}, {platform.machine()}.
 

@@ -17,12 +17,12 @@ A span is split only where a protect flag relevant to the Eval's order is raised
 With the §7.7 carry bug the adder is not linear, so those Evals take a per-column
 Python path through `bug_add` (correct, slower; only tests and demos use it).
 
-`render` batches every line whose Evals are all Eval1..Eval3 (`_Plan`), which is by far
-the common case, Set/SetP/Dis/Eval0/Acc_mode included: a scalar walk of each line turns
-its Evals into polynomial pieces (cut where a protect flag substitutes a register, split
-around disabled columns), each piece becomes six impulses in three difference arrays,
-and three cumulative sums per row give every D for the whole frame at once. Lines with
-Eval4+ or the carry bug go through the per-command path (`run_line`), which is also the
+`render` batches every line of a frame (`_Plan`), Set/SetP/Dis/Eval0/Acc_mode
+included: a scalar walk of each line turns its Evals into polynomial pieces (cut where a
+protect flag substitutes a register, split around disabled columns); a piece of degree
+<= 2 (Eval1..Eval3, by far the common case) becomes six impulses in three difference
+arrays, and three cumulative sums per row give every D for the whole frame at once.
+Only the carry bug goes through the per-command path (`run_line`), which is also the
 reference the batch is tested against (`_render_reference`).
 """
 from __future__ import annotations
@@ -285,8 +285,19 @@ def _advance(v0: int, v1: int, v2: int, n: int) -> tuple[int, int, int]:
     return ((v0 + n * v1 + (n * (n - 1) >> 1) * v2) & _W, (v1 + n * v2) & _W, v2)
 
 
+def _advance_n(v: list[int], n: int) -> list[int]:
+    """The same for any order p = len(v) - 1."""
+    p = len(v) - 1
+    return [sum(comb(n, k) * v[j + k] for k in range(p - j + 1)) & _W for j in range(p + 1)]
+
+
+def _expl(start: int, n: int, acc: bool, v) -> tuple[int, ...]:
+    """A piece expanded column by column: start, n, Acc_mode, v_0 .. v_7 (zero-padded)."""
+    return (start, n, acc, *v) + (0,) * (isa.MAX_EVAL_ORDER + 1 - len(v))
+
+
 class _Plan:
-    """Frame-wide batch of lines whose Evals are all of order <= 2 (no carry bug).
+    """Frame-wide batch of lines (any Eval order, no carry bug).
 
     Each line is walked command by command with Python scalars only: the protect, dis and
     lock flags that are raised are few, so they live in dicts keyed by column (a protect
@@ -295,8 +306,9 @@ class _Plan:
     polynomial val0(m) = v0 + m v1 + C(m, 2) v2 to D: the Eval is cut where a relevant
     protect flag substitutes a register (exactly the cuts of `_Line.eval`), and a cut
     piece is split again around columns whose dis flag suppresses the ACC. Pieces with
-    Acc_mode off go into difference arrays (`_finish`); with Acc_mode on, the sign of
-    every value matters, so they are expanded column by column (vectorised at the end).
+    Acc_mode off go into difference arrays (`finish`); with Acc_mode on, the sign of
+    every value matters, so they are expanded column by column (vectorised at the end),
+    as are the pieces of Eval4+ (degree > 2, rare), from the tabulated binomials.
     Eval0 locks D, and nothing changes a locked D, so the first Eval0 that gets through
     simply overrides the column's final D.
     """
@@ -306,16 +318,15 @@ class _Plan:
         self.stride = width + 3
         # pieces by order k = 0..2, flat: row offset, X, dX (clipped later), v_0 .. v_k
         self.poly: list[list[int]] = [[], [], []]
-        self.expl: list[tuple[int, int, int, int, int]] = []  # flat start, n, v0-v2: Acc_mode
+        self.expl: list[tuple[int, ...]] = []  # Acc_mode or Eval4+: see `_expl`
         self.over: list[tuple[int, int]] = []  # flat column, Eval0 intensity
         self.rows = 0
 
-    def line(self, cmds) -> bool:
-        """Plan one line as the next row; False (and nothing planned) if it has Eval4+."""
+    def line(self, cmds) -> None:
+        """Plan one line (its commands, a final Refresh allowed) as the next row."""
         w = self.width
         base = self.rows * self.stride
         poly, expl = self.poly, self.expl
-        undo = [len(t) for t in poly], len(expl)
         poly2 = poly[2]
         pv: list[dict[int, int]] = [{}, {}, {}]  # A, B, C: column -> Set value
         pk: list[list[int]] = [[], [], []]  # sorted keys of pv
@@ -330,10 +341,9 @@ class _Plan:
                 vals = c.values
                 p = len(vals) - 1
                 if p > 2:
-                    for t, n in zip(poly, undo[0]):
-                        del t[n:]
-                    del expl[undo[1]:]
-                    return False
+                    self._eval_high(c, base, pv, pk, dis, dk, acc)
+                    quiet = not (pk[0] or pk[1] or pk[2] or dk or acc)
+                    continue
                 if quiet:  # the common case
                     poly[p].extend((base, c.x, c.dx) + vals)
                     continue
@@ -369,13 +379,14 @@ class _Plan:
                         for col in dk[i:j]:
                             if col > q:
                                 if acc:
-                                    expl.append((base + q, col - q, *_advance(v0, v1, v2, q - s)))
+                                    expl.append(_expl(base + q, col - q, True,
+                                                      _advance(v0, v1, v2, q - s)))
                                 else:
                                     poly2.extend((base, q, col - q, *_advance(v0, v1, v2, q - s)))
                             q = col + 1
                     if t > q:
                         if acc:
-                            expl.append((base + q, t - q, *_advance(v0, v1, v2, q - s)))
+                            expl.append(_expl(base + q, t - q, True, _advance(v0, v1, v2, q - s)))
                         else:
                             poly2.extend((base, q, t - q, *_advance(v0, v1, v2, q - s)))
                     v0, v1, v2 = _advance(v0, v1, v2, t - s)
@@ -415,7 +426,38 @@ class _Plan:
                 raise ValueError(f"unknown command {op!r}")
         self.over.extend((base + col, i) for col, i in lock.items())
         self.rows += 1
-        return True
+
+    def _eval_high(self, c: isa.Command, base: int, pv, pk, dis, dk, acc: bool) -> None:
+        """An Eval of order p >= 3: only SetdI (B, d^(p-1)) and SetddI (C, d^p) count."""
+        w = self.width
+        a, e = min(c.x, w), min(c.x + c.dx, w)
+        if e <= a:
+            return
+        p = c.order
+        v = [x & _W for x in c.values]
+        cuts = {a}
+        for r in (1, 2):
+            ks = pk[r]
+            if ks:
+                i, j = bisect_left(ks, a), bisect_left(ks, e)
+                cuts.update(ks[i:j])
+        cuts = sorted(cuts)
+        cuts.append(e)
+        for k in range(len(cuts) - 1):
+            s, t = cuts[k], cuts[k + 1]
+            if s in pv[1]:
+                v[p - 1] = pv[1][s]
+            if s in pv[2]:
+                v[p] = pv[2][s]
+            q = s
+            for col in dk[bisect_left(dk, s):bisect_left(dk, t)] if dk else ():
+                if col > q:
+                    self.expl.append(_expl(base + q, col - q, acc, _advance_n(v, q - s)))
+                q = col + 1
+            if t > q:
+                self.expl.append(_expl(base + q, t - q, acc, _advance_n(v, q - s)))
+            v = _advance_n(v, t - s)
+        self._clear(a, e, pv, pk, dis, dk)
 
     @staticmethod
     def _clear(a, e, pv, pk, dis, dk):
@@ -473,17 +515,20 @@ class _Plan:
         d = np.cumsum(g[0] + np.cumsum(g[1] + np.cumsum(g[2], axis=1, dtype=np.uint64),
                                        axis=1, dtype=np.uint64), axis=1, dtype=np.uint64)
         flat = d.reshape(-1)
-        if self.expl:  # Acc_mode: only values with A >= 0 accumulate
+        if self.expl:  # val0(m) = sum_k C(m, k) v_k; with Acc_mode only where A >= 0
             t = np.array(self.expl, dtype=np.int64)
             n = t[:, 1]
             first = np.cumsum(n) - n
             piece = np.repeat(np.arange(len(t)), n)
-            m = (np.arange(int(n.sum()), dtype=np.int64) - first[piece]).view(np.uint64)
-            u = t.view(np.uint64)
-            val = (u[piece, 2] + m * u[piece, 3]
-                   + ((m * (m - np.uint64(1))) >> np.uint64(1)) * u[piece, 4]) & MASK
-            ok = (val & SIGN) == 0
-            np.add.at(flat, (t[piece, 0] + m.view(np.int64))[ok], val[ok])
+            m = np.arange(int(n.sum()), dtype=np.int64) - first[piece]
+            u = t[:, 3:].view(np.uint64)
+            val = u[piece, 0].copy()
+            for k in range(1, u.shape[1]):
+                if u[:, k].any():
+                    val += BINOM[k][m] * u[piece, k]
+            val &= MASK
+            ok = (t[piece, 2] == 0) | ((val & SIGN) == 0)
+            np.add.at(flat, (t[piece, 0] + m)[ok], val[ok])
         if self.over:  # Eval0: a locked D is the Eval0 intensity, whatever else ran
             t = np.array(self.over, dtype=np.int64)
             flat[t[:, 0]] = t[:, 1].view(np.uint64) << np.uint64(isa.FRAC_BITS)
@@ -517,11 +562,12 @@ def render(commands, width: int = 640, carry_bug: bool = False) -> np.ndarray:
                       stacklevel=2)
         lines.pop()
     out = np.zeros((len(lines), width), dtype=np.uint16)
-    plan = _Plan(width)
-    fast = [] if carry_bug else [i for i, ln in enumerate(lines) if plan.line(ln)]
-    if fast:
-        out[fast] = plan.finish()
-    slow = sorted(set(range(len(lines))) - set(fast))
-    for i in slow:
-        out[i] = run_line(lines[i], width, carry_bug)[0]
+    if carry_bug:  # the faulty adder is not linear: command by command, column by column
+        for i, ln in enumerate(lines):
+            out[i] = run_line(ln, width, carry_bug)[0]
+    elif lines:
+        plan = _Plan(width)
+        for ln in lines:
+            plan.line(ln)
+        out[:] = plan.finish()
     return out

@@ -4,8 +4,8 @@
 command, the model's reference for *what* is computed). The batch must give the same
 pixels on streams rich in what it treats specially: protect flags (Set, periodic SetP
 with dX 0/1/n), Dis, Eval0 locks, Acc_mode, spans past the end, X beyond the array,
-dX 0/1, values that wrap modulo 2^36, and lines with Eval4+ that fall back to the
-per-command path in between batched ones.
+dX 0/1, values that wrap modulo 2^36, and Eval4+ (whose pieces the batch expands
+column by column, with only SetdI/SetddI honoured).
 
 Seeded; the seed is printed and SEED=<n> replays it
 (`SEED=123 pytest -q sw/tests/test_functional_batch.py`).
