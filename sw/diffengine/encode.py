@@ -207,7 +207,7 @@ class ChannelEncoder:
         if self._spline_quick(d, 10 ** hi)[0] >= target:
             ok = hi
         else:
-            for _ in range(18):
+            for _ in range(13):
                 mid = (lo + hi) / 2
                 if self._spline_quick(d, 10 ** mid)[0] >= target:
                     lo, ok = mid, mid
@@ -229,7 +229,7 @@ class ChannelEncoder:
             return exact
         lo, hi = LAM_LO, LAM_HI + 3
         best = hi
-        for _ in range(18):
+        for _ in range(13):
             mid = (lo + hi) / 2
             if self._spline_quick(d, 10 ** mid)[1] <= max_slots:
                 hi, best = mid, mid
