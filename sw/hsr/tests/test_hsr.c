@@ -81,6 +81,51 @@ static void test_hsr_tri_steps_all_visible_tri_spets_one_visible(void)
     hsr_destroy(h); hsr_destroy(g);
 }
 
+/* An opaque domain in front that covers whole LLR domains takes over one slot
+ * and its parent list (add_domain's covered-slot shortcut): tri-spets reversed,
+ * a transparent prefix moved to the hidden parents, two covered domains with
+ * parent lists of different length, then removals that must repair from the
+ * hidden parents. */
+static void test_hsr_cover_takes_over_slot_tri_spets_reversed(void)
+{
+    hsr_ctx *h = t_ctx();
+    int ids[30];
+    for (int k = 0; k < 30; k++) {   /* smallest (farthest) first, each new one covers all */
+        int i = 29 - k;
+        int64_t s = 1000 - 30 * i;
+        int64_t tri[6] = {0, 0, s, 0, 0, s};
+        int n = 3;
+        hsr_plane p = {0, 0, (double)i};
+        CHECK(hsr_add(h, tri, &n, 1, p, k == 10 ? 0.5 : 1, &ids[k]) == HSR_OK);
+    }
+    const int *par; int nv, np, front = -1;
+    CHECK(llr_count(h) == 1 && hsr_check(h) == HSR_OK);
+    for (int s = 0; s < hsr_llr_slots(h); s++)
+        if (hsr_llr_get(h, s, NULL, &par, &nv, &np)) { front = par[0]; CHECK(nv == 1 && np == 30); }
+    CHECK(front == ids[29]);
+    CHECK_NEAR(t_visible_area(h, ids[29]), 500000, 1e-12);
+    CHECK(hsr_remove(h, ids[29]) == HSR_OK && hsr_check(h) == HSR_OK);
+    CHECK_NEAR(t_llr_total_area(h), 970.0 * 970.0 / 2, 1e-9);
+    CHECK_NEAR(t_visible_area(h, ids[28]), 970.0 * 970.0 / 2, 1e-9);
+
+    /* transparent prefix: a glass square over an opaque one, then an opaque cover */
+    hsr_ctx *g = t_ctx();
+    int a = t_add_rect(g, 0, 0, 100, 100, 0, 5, 1);
+    int gl = t_add_rect(g, 0, 0, 100, 100, 0, 4, 0.5);
+    int b = t_add_rect(g, 200, 0, 260, 100, 0, 5, 1);        /* a second, shorter-listed domain */
+    int c = t_add_rect(g, -10, -10, 300, 120, 0, 1, 1);      /* covers both */
+    CHECK(a >= 0 && gl >= 0 && b >= 0 && c >= 0);
+    CHECK(llr_count(g) == 1 && hsr_check(g) == HSR_OK);
+    int nvis, ninv;
+    CHECK(hsr_mlr_get(g, gl, NULL, NULL, NULL, &nvis, &ninv) && nvis == 0 && ninv == 1);
+    CHECK_NEAR(t_visible_area(g, c), 310.0 * 130, 1e-9);
+    CHECK(hsr_remove(g, c) == HSR_OK && hsr_check(g) == HSR_OK);
+    CHECK_NEAR(t_visible_area(g, gl), 10000, 1e-9);
+    CHECK_NEAR(t_visible_area(g, b), 6000, 1e-9);
+    CHECK(hsr_mlr_get(g, a, NULL, NULL, NULL, &nvis, &ninv) && nvis == 1 && ninv == 0);
+    hsr_destroy(h); hsr_destroy(g);
+}
+
 static void test_hsr_remove_repairs_damage(void)
 {
     hsr_ctx *h = t_ctx();
@@ -193,6 +238,7 @@ void suite_hsr(void)
 {
     RUN(test_hsr_two_opaque_overlap_any_order);
     RUN(test_hsr_tri_steps_all_visible_tri_spets_one_visible);
+    RUN(test_hsr_cover_takes_over_slot_tri_spets_reversed);
     RUN(test_hsr_remove_repairs_damage);
     RUN(test_hsr_transparent_parents_and_pick);
     RUN(test_hsr_interpenetrating_squares);
