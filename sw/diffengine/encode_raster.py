@@ -78,9 +78,14 @@ def from8(x8: np.ndarray) -> np.ndarray:
     return (np.asarray(x8, dtype=np.int64) * PIXEL_MAX + 127) // 255
 
 
-def jpeg_roundtrip(x12: np.ndarray, quality: int, path: str | None = None) -> tuple[int, np.ndarray]:
+def jpeg_roundtrip(x12: np.ndarray, quality: int, path: str | None = None,
+                   subsampling: str = "4:4:4") -> tuple[int, np.ndarray]:
     """Encode (rows, cols[, 3]) 12-bit pixels as an 8-bit JPEG at `quality`; return the
-    file size in bytes and the decoded image back on the 12-bit scale."""
+    file size in bytes and the decoded image back on the 12-bit scale.
+
+    Colour is coded without chroma subsampling by default (4:4:4: every channel at full
+    resolution, as the spline streams are); OpenImageIO's own default is 4:2:0, which
+    caps the shaded-spheres image at 39.1 dB even at quality 100."""
     import OpenImageIO as oiio
 
     data = to8(x12)
@@ -89,6 +94,8 @@ def jpeg_roundtrip(x12: np.ndarray, quality: int, path: str | None = None) -> tu
     h, w, c = (int(v) for v in data.shape)
     spec = oiio.ImageSpec(w, h, c, oiio.UINT8)
     spec.attribute("Compression", f"jpeg:{int(quality)}")
+    if c == 3 and subsampling:
+        spec.attribute("jpeg:subsampling", subsampling)
     buf = oiio.ImageBuf(spec)
     buf.set_pixels(oiio.ROI(), np.ascontiguousarray(data))
     tmp = None
