@@ -29,7 +29,10 @@ piecewise-linear Eval2 + SetdI knots or quadratic Eval3 + SetddI knots), `rle` (
 runs, lossy with a tolerance) and `raster` (Eval0 per pixel). Targets: `--psnr` (the
 achieved PSNR is >= the target; lam is searched), `--slots-per-line` (every line fits,
 e.g. 800 for 640x480@60), `--bytes` (48-bit stream, 6 bytes per instruction), or
-`--lossless` (exact). Baselines (`--baselines`): the Eval0 raster, the lossless RLE
+`--lossless` (exact). Spline emission (`--emission`): knots - `merged`, `layered`, `auto`
+(default: the cheaper of the two per line) - or per basis function - `coefficient` (one
+accumulated Eval per kept pyramid atom) and `choice` (per atom, own Eval or knots,
+whichever costs fewer instructions); docs/reconstruction.md compares them. Baselines (`--baselines`): the Eval0 raster, the lossless RLE
 raster and a JPEG at the spline stream's byte size, written next to the output.
 """
 from __future__ import annotations
