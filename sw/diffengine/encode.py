@@ -222,7 +222,10 @@ class ChannelEncoder:
         while res.psnr < target:  # non-monotone corner: step down (lam -> 0 is exact)
             ok -= 0.25
             res = self.spline_lam(d, 10 ** ok) if ok > LAM_LO - 2 else self.spline_lossless(d)
-        return res
+        # instructions are not monotone in lam either (patches, refit): on step-edge
+        # images the exact code can be the cheaper one
+        exact = self.spline_lossless(d)
+        return exact if exact.slots <= res.slots else res
 
     def spline_bytes(self, d: int, max_bytes: int) -> Result:
         """Smallest lam (best quality) whose stream has at most max_bytes."""

@@ -114,6 +114,14 @@ def test_psnr_target_other_images():
         assert res.psnr >= 40.0, name
 
 
+def test_psnr_target_never_dearer_than_lossless():
+    # step edges: lossy lam can cost more than the exact code (patches); take the exact one
+    x = crop("bars", rows=12)
+    enc = EN.ChannelEncoder(x)
+    for codec in ("spline1", "spline2"):
+        assert enc.encode(codec, psnr=40.0).slots <= enc.encode(codec, lossless=True).slots
+
+
 def test_slot_budget_per_line(natural):
     enc = EN.ChannelEncoder(natural)
     for budget in (40, 120):
