@@ -11,7 +11,7 @@ the PSNR reaches --min-psnr.
 
 A smaller array (--chips) only makes sense with a smaller screen: the array needs at
 least ceil(width / 9) chips per colour; screens other than 640x480 run the controller's
-test mode with a 640x480-length line (799 command slots per line).
+test mode with a 640x480-length line (798 usable command slots per line).
 """
 from __future__ import annotations
 

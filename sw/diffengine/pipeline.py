@@ -28,7 +28,7 @@ from . import binfmt, dc_harness, frame, functional, reference
 REPO = Path(__file__).resolve().parents[2]
 YPROC = REPO / "sw" / "hsr" / "build" / "yproc"
 MIN_PSNR = 38.0
-H_TOTAL = 800          # 640x480's line: 799 command slots per line in every mode we run
+H_TOTAL = 800          # 640x480's line: a 799-slot window, 798 usable (docs/pipeline.md 1.1)
 
 
 class PipelineError(RuntimeError):
