@@ -1,0 +1,512 @@
+// Difference Engine: the span-serial virtual array (docs/fpga.md, "Span-serial array").
+//
+// The same architectural state as NumCols x-processors (A-D, protect, dis and lock flags
+// per column; docs/isa.md section 6), kept in one block RAM, and the same pixels for the
+// same 48-bit instruction stream, but the work is done only where a command acts. The
+// plain array passes every slot through every PE (NumCols operations per slot); here a
+// command visits only the columns of its span, one column per clock.
+//
+//   front end   collects a *group*: an address slot and the data/ACC slots behind it
+//               (they act exactly on the address slot's span, isa.md section 5), writes
+//               it into a 16-entry pass table; a group of more than MaxSlots slots is
+//               split into passes of MaxSlots (each slot is its own chain, so a split
+//               is exact). Refresh is a pass over every column.
+//   issue       walks a pass's columns (range: X..X+dX-1, periodic: X, X+dX, ...,
+//               clipped at NumCols), one token per clock, reading the column's state.
+//   stage 0     Eval0 / Dis of the address slot, Refresh (pixel out, state cleared).
+//   stage 1..K  slot j-1 of the pass: forward differencing with the value carried from
+//               the previous column of the same pass (cv_q), or ACC (D += A).
+//   write back  the column's state, K+2 clocks after it was read.
+//
+// A token is not issued while its column is in flight (read, not yet written back), so
+// passes over overlapping spans see each other's results in stream order.
+//
+// Interface: a valid/ready stream of unskewed slots in, a pixel stream out (NumCols
+// pixels per Refresh, in column order, with their column). Acc_mode is global state:
+// every column sees Acc_mode and Refresh slots in the same order relative to every other
+// command, so one register captured per pass is the per-column flag of the plain array.
+// Reset: rst_i for one clock; the state RAM is then cleared column by column (NumCols
+// clocks, busy_o high) before the first pass is issued.
+module de_span_array
+  import de_pkg::*;
+#(
+  parameter int unsigned NumCols  = 648,  // virtual columns (x-processors)
+  parameter int unsigned MaxSlots = 4,    // data/ACC slots per pass (4 = Eval3 in one)
+  parameter int unsigned CarryBug = 0
+) (
+  input  logic             clk_i,
+  input  logic             rst_i,
+  input  logic             instr_valid_i,
+  output logic             instr_ready_o,
+  input  logic [IdW-1:0]   ident_i,
+  input  logic [DataW-1:0] data_i,
+  output logic             pixel_valid_o,
+  output logic [PixW-1:0]  pixel_o,
+  output logic [11:0]      pixel_col_o,
+  output logic             busy_o         // passes queued or in flight, or clearing
+);
+  localparam int unsigned K    = MaxSlots;
+  localparam int unsigned CW   = 13;                 // column counter: X + dX < 8192
+  localparam int unsigned AW   = NumCols > 1 ? $clog2(NumCols) : 1;
+  localparam int unsigned PW   = 4;                  // pass table: 16 entries
+  localparam int unsigned NPass = 1 << PW;
+  // Column state: A, B, C, D, pA, pB, pC, dis, lock.
+  localparam int unsigned StW  = 4 * DataW + 5;
+
+  if (NumCols < 1 || NumCols > 4096) begin : g_bad_cols
+    $fatal(1, "de_span_array: NumCols must be 1..4096, got %0d", NumCols);
+  end
+  if (MaxSlots < 1 || MaxSlots > 9) begin : g_bad_slots
+    $fatal(1, "de_span_array: MaxSlots must be 1..9 (Eval8 = 9), got %0d", MaxSlots);
+  end
+  if (CarryBug > 1) begin : g_bad_carry_bug
+    $fatal(1, "de_span_array: CarryBug must be 0 or 1");
+  end
+
+  typedef struct packed {
+    logic [DataW-1:0] a, b, c, d;
+    logic pa, pb, pc, dis, lock;
+  } st_t;
+
+  // One slot of a pass: what the identifier's direct bits say, and its value.
+  typedef struct packed {
+    logic             acc;     // ACC slot (else data slot)
+    logic [1:0]       dst, src;
+    logic             set, prot;
+    logic [DataW-1:0] val;
+  } slot_t;
+
+  // A token: one column of one pass on its way through the pipeline.
+  typedef struct packed {
+    logic          vld;
+    logic          nul;        // empty pass: retires, touches no column
+    logic          clr;        // reset sweep: clear the column
+    logic          rfr;        // Refresh: pixel out, clear the column
+    logic [1:0]    eff;        // address slot's own effect: 0 none, 1 Eval0, 2 Dis
+    logic [PixW-1:0] i12;      // Eval0 intensity
+    logic          accm;       // Acc_mode in force for the pass's ACC slots
+    logic [3:0]    nslot;      // slots of the pass (stages beyond them pass through)
+    logic          first;      // first column of the pass: chains start from the slot
+    logic          last;       // last token of the pass: it retires the table entry
+    logic [PW-1:0] ptr;        // pass table entry
+    logic [CW-1:0] col;
+  } tok_t;
+
+  localparam logic [1:0] EffNone = 2'd0, EffEval0 = 2'd1, EffDis = 2'd2;
+
+  // The prototype's adder, with its carry fault as an option (isa.md section 7): the
+  // carry out of bit 23 enters the integer part at bit 25 instead of bit 24.
+  function automatic logic [DataW-1:0] add36(input logic [DataW-1:0] x,
+                                             input logic [DataW-1:0] y);
+    logic [24:0] lo;
+    logic [11:0] hi;
+    lo = {1'b0, x[23:0]} + {1'b0, y[23:0]};
+    hi = x[35:24] + y[35:24] + (12'(lo[24]) << CarryBug);
+    return {hi, lo[23:0]};
+  endfunction
+
+  function automatic logic [DataW-1:0] reg_of(input st_t s, input logic [1:0] code);
+    case (code)
+      RegA:    return s.a;
+      RegB:    return s.b;
+      RegC:    return s.c;
+      default: return '0;
+    endcase
+  endfunction
+
+  function automatic logic flag_of(input st_t s, input logic [1:0] code);
+    case (code)
+      RegA:    return s.pa;
+      RegB:    return s.pb;
+      RegC:    return s.pc;
+      default: return 1'b0;
+    endcase
+  endfunction
+
+  // ==== front end: slots -> pass table ====================================================
+  id_t id;
+  assign id = id_t'(ident_i);
+
+  // Pass table. The header fields travel in the token (read once, at issue); slot j is
+  // read only by stage j+1, so each slot column is its own small memory with one read
+  // port (distributed RAM).
+  typedef struct packed {
+    logic          rfr;
+    logic          per;        // periodic addressing
+    logic [1:0]    eff;
+    logic [11:0]   x, dx;      // range: X, dX. periodic: X (first column), dX (period)
+    logic [PixW-1:0] i12;
+    logic          accm;
+    logic [3:0]    nslot;
+  } hdr_t;
+  hdr_t  hdr_mem [NPass];
+  slot_t slot_mem [K][NPass];
+
+  logic [PW:0] wr_cnt_d, wr_cnt_q, iss_cnt_d, iss_cnt_q, ret_cnt_d, ret_cnt_q;
+  logic [PW-1:0] wr_ptr, iss_ptr;
+  assign wr_ptr  = wr_cnt_q[PW-1:0];
+  assign iss_ptr = iss_cnt_q[PW-1:0];
+  logic room;
+  // Entry wr_ptr is free while fewer than NPass passes are committed and not retired.
+  assign room = (PW + 1)'(wr_cnt_q - ret_cnt_q) < (PW + 1)'(NPass);
+
+  // The open group.
+  logic        open_d, open_q, per_d, per_q, accm_d, accm_q;
+  logic [1:0]  eff_d, eff_q;
+  logic [11:0] x_d, x_q, dx_d, dx_q;
+  logic [PixW-1:0] i12_d, i12_q;
+  logic [3:0]  nslot_d, nslot_q;
+
+  logic is_dat, closer, full, pend, commit, take, slot_we, ref_we;
+  hdr_t hdr_w;
+  assign is_dat = !id.addr && !id.refresh && (id.data || id.acc);
+  assign closer = !is_dat;
+  assign full   = (nslot_q == 4'(K));
+  // The group holds something to do: slots, or an Eval0 / Dis of its own.
+  assign pend   = open_q && ((nslot_q != '0) || (eff_q != EffNone));
+  // A slot that ends the group (or overflows it) waits one clock while the group is
+  // written: one table write per clock, in stream order.
+  assign commit = instr_valid_i && pend && (closer || full) && room;
+  assign take   = instr_valid_i && !(pend && (closer || full)) &&
+                  (room || !(id.refresh || (is_dat && open_q)));
+  assign slot_we = take && is_dat && open_q;
+  assign ref_we  = take && id.refresh;
+
+  always_comb begin
+    hdr_w       = '0;
+    hdr_w.per   = per_q;
+    hdr_w.eff   = eff_q;
+    hdr_w.x     = x_q;
+    hdr_w.dx    = dx_q;
+    hdr_w.i12   = i12_q;
+    hdr_w.accm  = accm_q;
+    hdr_w.nslot = nslot_q;
+    if (ref_we) begin
+      hdr_w       = '0;
+      hdr_w.rfr   = 1'b1;
+    end
+  end
+
+  always_comb begin
+    open_d   = open_q;
+    per_d    = per_q;
+    eff_d    = eff_q;
+    x_d      = x_q;
+    dx_d     = dx_q;
+    i12_d    = i12_q;
+    nslot_d  = nslot_q;
+    accm_d   = accm_q;
+    wr_cnt_d = wr_cnt_q;
+    if (commit) begin
+      wr_cnt_d = wr_cnt_q + 1'b1;
+      // An overflowing group goes on over the same span with its next slots; the address
+      // slot's own effect belongs to the first pass only.
+      open_d  = !closer;
+      nslot_d = '0;
+      eff_d   = EffNone;
+    end
+    if (take) begin
+      open_d = 1'b0;
+      if (id.addr) begin
+        open_d  = 1'b1;
+        nslot_d = '0;
+        per_d   = (id.sub == SubPeriodic);
+        eff_d   = (id.sub == SubEval0) ? EffEval0 : (id.sub == SubDis) ? EffDis : EffNone;
+        // Periodic layout: the period in block 0, the first column in block 1 (isa.md 4).
+        x_d     = per_d ? data_i[23:12] : data_i[11:0];
+        dx_d    = per_d ? data_i[11:0] : data_i[23:12];
+        i12_d   = data_i[35:24];
+      end else if (is_dat) begin
+        // Data slots with no address slot in front act nowhere (act = 0 everywhere).
+        open_d  = open_q;
+        nslot_d = nslot_q + 4'(open_q);
+      end else if (id.refresh) begin
+        accm_d   = 1'b0;
+        wr_cnt_d = wr_cnt_q + 1'b1;
+      end else if (id.sub == SubAccModeOn) begin
+        accm_d = 1'b1;
+      end else if (id.sub == SubAccModeOff) begin
+        accm_d = 1'b0;
+      end
+    end
+  end
+  assign instr_ready_o = take;
+
+  always_ff @(posedge clk_i) begin
+    if (commit || ref_we) begin
+      hdr_mem[wr_ptr] <= hdr_w;
+    end
+  end
+
+  for (genvar j = 0; j < K; j++) begin : g_slot_mem
+    always_ff @(posedge clk_i) begin
+      if (slot_we && (nslot_q == 4'(j))) begin
+        slot_mem[j][wr_ptr] <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
+      end
+    end
+  end
+
+  // ==== issue: walk the columns of the oldest pass ======================================
+  logic          run_d, run_q, scrub_d, scrub_q;
+  logic [CW-1:0] col_d, col_q, end_d, end_q, step_d, step_q;
+  tok_t          cur_d, cur_q;        // the running pass's token template
+  tok_t          iss;                 // token issued this clock (vld = 0: none)
+  logic          hazard;
+  tok_t          tok_q [K + 2];       // tok_q[s]: token in stage s (K+1: write back)
+
+  always_comb begin
+    hazard = 1'b0;
+    for (int s = 0; s < K + 2; s++) begin
+      if (tok_q[s].vld && !tok_q[s].nul && (tok_q[s].col == col_q)) begin
+        hazard = 1'b1;
+      end
+    end
+  end
+
+  hdr_t hr;
+  assign hr = hdr_mem[iss_ptr];
+
+  always_comb begin
+    run_d     = run_q;
+    scrub_d   = scrub_q;
+    col_d     = col_q;
+    end_d     = end_q;
+    step_d    = step_q;
+    cur_d     = cur_q;
+    iss_cnt_d = iss_cnt_q;
+    iss       = cur_q;
+    iss.vld   = 1'b0;
+    iss.col   = col_q;
+    iss.last  = (col_q + step_q >= end_q);
+    if (scrub_q) begin
+      // Reset sweep: clear every column (block RAM has no reset).
+      iss.vld = 1'b1;
+      iss.clr = 1'b1;
+      iss.nul = 1'b0;
+      iss.last = 1'b0;
+      col_d   = col_q + 1'b1;
+      if (col_q == CW'(NumCols - 1)) begin
+        scrub_d = 1'b0;
+      end
+    end else if (run_q) begin
+      if (cur_q.nul || !hazard) begin
+        iss.vld = 1'b1;
+        col_d   = col_q + step_q;
+        cur_d.first = 1'b0;
+        if (cur_q.nul || iss.last) begin
+          iss.last  = 1'b1;
+          run_d     = 1'b0;
+          iss_cnt_d = iss_cnt_q + 1'b1;
+        end
+      end
+    end else if (iss_cnt_q != wr_cnt_q) begin
+      // Load the next pass (one clock): its column range and its token template.
+      run_d       = 1'b1;
+      cur_d       = '0;
+      cur_d.first = 1'b1;
+      cur_d.ptr   = iss_ptr;
+      cur_d.rfr   = hr.rfr;
+      cur_d.eff   = hr.eff;
+      cur_d.i12   = hr.i12;
+      cur_d.accm  = hr.accm;
+      cur_d.nslot = hr.nslot;
+      if (hr.rfr) begin
+        col_d  = '0;
+        end_d  = CW'(NumCols);
+        step_d = CW'(1);
+      end else if (hr.per) begin
+        // Period dX; dX = 0 reloads the countdown with 4095: period 4096 (isa.md 5).
+        col_d  = CW'(hr.x);
+        end_d  = CW'(NumCols);
+        step_d = (hr.dx == '0) ? CW'(4096) : CW'(hr.dx);
+      end else begin
+        col_d  = CW'(hr.x);
+        end_d  = (CW'(hr.x) + CW'(hr.dx) < CW'(NumCols)) ? CW'(hr.x) + CW'(hr.dx)
+                                                        : CW'(NumCols);
+        step_d = CW'(1);
+      end
+      cur_d.nul = (col_d >= end_d);
+    end
+  end
+
+  // ==== pipeline ===========================================================================
+  logic [StW-1:0] ram [NumCols];
+  st_t  rd_q;                          // column state read in the issue clock
+  st_t  st_q [1:K + 1];                // st_q[s]: state entering stage s
+  logic [DataW-1:0] cv_d [1:K], cv_q [1:K];  // per stage: value out of the last column
+  st_t  st_s [1:K + 1];                // stage outputs (st_s[s] -> st_q[s])
+  logic pixv_d, pixv_q;
+  logic [PixW-1:0] pix_d, pix_q;
+  logic [11:0] pixc_d, pixc_q;
+
+  // Stage 0: the address slot's own effect and Refresh.
+  always_comb begin
+    st_s[1] = rd_q;
+    pixv_d  = 1'b0;
+    pix_d   = '0;
+    pixc_d  = 12'(tok_q[0].col);
+    if (tok_q[0].vld && !tok_q[0].nul) begin
+      if (tok_q[0].rfr || tok_q[0].clr) begin
+        pixv_d  = tok_q[0].rfr;
+        pix_d   = rd_q.d[DataW-1 -: PixW];
+        st_s[1] = '0;
+      end else if (tok_q[0].eff == EffEval0) begin
+        if (!rd_q.lock && !rd_q.dis) begin
+          st_s[1].d    = {tok_q[0].i12, 24'd0};
+          st_s[1].lock = 1'b1;
+        end
+        st_s[1].pa  = 1'b0;
+        st_s[1].pb  = 1'b0;
+        st_s[1].pc  = 1'b0;
+        st_s[1].dis = 1'b0;
+      end else if (tok_q[0].eff == EffDis) begin
+        st_s[1].dis = 1'b1;
+      end
+    end
+  end
+
+  // Stages 1..K: slot j of the pass (isa.md section 6, architectural form).
+  for (genvar s = 1; s <= K; s++) begin : g_stage
+    slot_t sl;
+    logic  on;
+    logic [DataW-1:0] vin, v, sum;
+    logic  prot;
+    st_t   st;
+    assign sl = slot_mem[s - 1][tok_q[s].ptr];
+    assign on = tok_q[s].vld && !tok_q[s].nul && !tok_q[s].clr && !tok_q[s].rfr &&
+                (tok_q[s].nslot > 4'(s - 1));
+    // The first column of a pass gets the slot's own value; inactive columns between
+    // active ones pass values unchanged, so every later column gets its left neighbour's.
+    assign vin  = tok_q[s].first ? sl.val : cv_q[s];
+    assign prot = sl.prot && flag_of(st_q[s], sl.dst);
+    assign v    = prot ? reg_of(st_q[s], sl.dst) : vin;
+    // One adder per stage: D + A for ACC, the value plus SRC (read before DST is written)
+    // for a data slot.
+    assign sum  = sl.acc ? add36(st_q[s].d, st_q[s].a) : add36(v, reg_of(st_q[s], sl.src));
+
+    always_comb begin
+      st      = st_q[s];
+      cv_d[s] = cv_q[s];
+      if (on && !sl.acc) begin
+        if (sl.set) begin
+          cv_d[s] = vin;
+          case (sl.dst)
+            RegA: begin st.a = vin; st.pa = 1'b1; end
+            RegB: begin st.b = vin; st.pb = 1'b1; end
+            RegC: begin st.c = vin; st.pc = 1'b1; end
+            default: ;
+          endcase
+        end else begin
+          cv_d[s] = sum;
+          case (sl.dst)
+            RegA:    st.a = v;
+            RegB:    st.b = v;
+            RegC:    st.c = v;
+            default: ;
+          endcase
+        end
+      end
+      if (on && sl.acc) begin
+        // Acc_mode drops a negative A (bit 35) from the sum.
+        if (!st_q[s].lock && !st_q[s].dis && !(tok_q[s].accm && st_q[s].a[DataW-1])) begin
+          st.d = sum;
+        end
+        st.pa  = 1'b0;
+        st.pb  = 1'b0;
+        st.pc  = 1'b0;
+        st.dis = 1'b0;
+      end
+      st_s[s + 1] = st;
+    end
+  end
+
+  // Write back, and retire the pass with its last token.
+  tok_t wb;
+  assign wb = tok_q[K + 1];
+  always_comb begin
+    ret_cnt_d = ret_cnt_q;
+    if (wb.vld && wb.last) begin
+      ret_cnt_d = ret_cnt_q + 1'b1;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (iss.vld && !iss.nul) begin
+      rd_q <= st_t'(ram[AW'(iss.col)]);
+    end
+    if (wb.vld && !wb.nul) begin
+      ram[AW'(wb.col)] <= StW'(st_q[K + 1]);
+    end
+  end
+
+  // ==== registers ===========================================================================
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      open_q    <= 1'b0;
+      per_q     <= 1'b0;
+      eff_q     <= EffNone;
+      x_q       <= '0;
+      dx_q      <= '0;
+      i12_q     <= '0;
+      nslot_q   <= '0;
+      accm_q    <= 1'b0;
+      wr_cnt_q  <= '0;
+      iss_cnt_q <= '0;
+      ret_cnt_q <= '0;
+      run_q     <= 1'b0;
+      scrub_q   <= 1'b1;
+      col_q     <= '0;
+      end_q     <= '0;
+      step_q    <= '0;
+      cur_q     <= '0;
+      pixv_q    <= 1'b0;
+      pix_q     <= '0;
+      pixc_q    <= '0;
+      for (int s = 0; s < K + 2; s++) begin
+        tok_q[s] <= '0;
+      end
+    end else begin
+      open_q    <= open_d;
+      per_q     <= per_d;
+      eff_q     <= eff_d;
+      x_q       <= x_d;
+      dx_q      <= dx_d;
+      i12_q     <= i12_d;
+      nslot_q   <= nslot_d;
+      accm_q    <= accm_d;
+      wr_cnt_q  <= wr_cnt_d;
+      iss_cnt_q <= iss_cnt_d;
+      ret_cnt_q <= ret_cnt_d;
+      run_q     <= run_d;
+      scrub_q   <= scrub_d;
+      col_q     <= col_d;
+      end_q     <= end_d;
+      step_q    <= step_d;
+      cur_q     <= cur_d;
+      pixv_q    <= pixv_d;
+      pix_q     <= pix_d;
+      pixc_q    <= pixc_d;
+      tok_q[0]  <= iss;
+      for (int s = 1; s < K + 2; s++) begin
+        tok_q[s] <= tok_q[s - 1];
+      end
+    end
+  end
+
+  // Datapath registers: no reset (the reset sweep defines the state before use).
+  always_ff @(posedge clk_i) begin
+    for (int s = 1; s <= K + 1; s++) begin
+      st_q[s] <= st_s[s];
+    end
+    for (int s = 1; s <= K; s++) begin
+      cv_q[s] <= cv_d[s];
+    end
+  end
+
+  assign pixel_valid_o = pixv_q;
+  assign pixel_o       = pix_q;
+  assign pixel_col_o   = pixc_q;
+  assign busy_o        = scrub_q || run_q || (wr_cnt_q != ret_cnt_q) ||
+                         (iss_cnt_q != wr_cnt_q);
+
+endmodule
