@@ -81,7 +81,8 @@ module de_span_array
     logic          vld;
     logic          nul;        // empty pass: retires, touches no column
     logic          clr;        // reset sweep: clear the column
-    logic          rfr;        // Refresh: pixel out, clear the column
+    logic          rfr;        // Refresh: the bank switch (one token per Refresh)
+    logic          bank;       // state bank the token reads and writes
     logic [1:0]    eff;        // address slot's own effect: 0 none, 1 Eval0, 2 Dis
     logic [PixW-1:0] i12;      // Eval0 intensity
     logic          accm;       // Acc_mode in force for the pass's ACC slots
@@ -94,31 +95,42 @@ module de_span_array
 
   localparam logic [1:0] EffNone = 2'd0, EffEval0 = 2'd1, EffDis = 2'd2;
 
+  tok_t tok_q [K + 2];                 // tok_q[s]: token in stage s (K+1: write back)
+
   // The prototype's adder, with its carry fault as an option (isa.md section 7): the
   // carry out of bit 23 enters the integer part at bit 25 instead of bit 24.
   function automatic logic [DataW-1:0] add36(input logic [DataW-1:0] x,
                                              input logic [DataW-1:0] y);
     logic [24:0] lo;
     logic [11:0] hi;
+    if (CarryBug == 0) begin
+      // One carry chain: the fault's form below puts two chains in series.
+      return x + y;
+    end
     lo = {1'b0, x[23:0]} + {1'b0, y[23:0]};
-    hi = x[35:24] + y[35:24] + (12'(lo[24]) << CarryBug);
+    hi = x[35:24] + y[35:24] + {10'd0, lo[24], 1'b0};
     return {hi, lo[23:0]};
   endfunction
 
-  function automatic logic [DataW-1:0] reg_of(input st_t s, input logic [1:0] code);
+  // Register read port: code 0 (none) reads as zero ("adds 0"), as in de_pe.
+  function automatic logic [DataW-1:0] reg_of(input logic [DataW-1:0] a,
+                                              input logic [DataW-1:0] b,
+                                              input logic [DataW-1:0] c,
+                                              input logic [1:0] code);
     case (code)
-      RegA:    return s.a;
-      RegB:    return s.b;
-      RegC:    return s.c;
+      RegA:    return a;
+      RegB:    return b;
+      RegC:    return c;
       default: return '0;
     endcase
   endfunction
 
-  function automatic logic flag_of(input st_t s, input logic [1:0] code);
+  function automatic logic flag_of(input logic pa, input logic pb, input logic pc,
+                                   input logic [1:0] code);
     case (code)
-      RegA:    return s.pa;
-      RegB:    return s.pb;
-      RegC:    return s.pc;
+      RegA:    return pa;
+      RegB:    return pb;
+      RegC:    return pc;
       default: return 1'b0;
     endcase
   endfunction
@@ -140,7 +152,7 @@ module de_span_array
     logic [3:0]    nslot;
   } hdr_t;
   hdr_t  hdr_mem [NPass];
-  slot_t slot_mem [K][NPass];
+  slot_t slot_q [K];                   // slot j of the pass in stage j+1 (registered)
 
   logic [PW:0] wr_cnt_d, wr_cnt_q, iss_cnt_d, iss_cnt_q, ret_cnt_d, ret_cnt_q;
   logic [PW-1:0] wr_ptr, iss_ptr;
@@ -238,21 +250,27 @@ module de_span_array
     end
   end
 
+  // One memory per slot position: one write port (the front end) and one read port,
+  // which is what maps onto distributed RAM. It is read for the token one stage ahead
+  // and registered, so no RAM read sits in front of a stage's adder.
   for (genvar j = 0; j < K; j++) begin : g_slot_mem
+    (* ram_style = "distributed" *) slot_t mem [NPass];
     always_ff @(posedge clk_i) begin
       if (slot_we && (nslot_q == 4'(j))) begin
-        slot_mem[j][wr_ptr] <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
+        mem[wr_ptr] <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
       end
+      slot_q[j] <= mem[tok_q[j].ptr];
     end
   end
 
   // ==== issue: walk the columns of the oldest pass ======================================
   logic          run_d, run_q, scrub_d, scrub_q;
+  logic          bank_d, bank_q;      // the bank the engine works on (this line's)
+  logic          drain_busy;
   logic [CW-1:0] col_d, col_q, end_d, end_q, step_d, step_q;
   tok_t          cur_d, cur_q;        // the running pass's token template
   tok_t          iss;                 // token issued this clock (vld = 0: none)
   logic          hazard;
-  tok_t          tok_q [K + 2];       // tok_q[s]: token in stage s (K+1: write back)
 
   always_comb begin
     hazard = 1'b0;
@@ -269,6 +287,7 @@ module de_span_array
   always_comb begin
     run_d     = run_q;
     scrub_d   = scrub_q;
+    bank_d    = bank_q;
     col_d     = col_q;
     end_d     = end_q;
     step_d    = step_q;
@@ -277,6 +296,7 @@ module de_span_array
     iss       = cur_q;
     iss.vld   = 1'b0;
     iss.col   = col_q;
+    iss.bank  = bank_q;
     iss.last  = (col_q + step_q >= end_q);
     if (scrub_q) begin
       // Reset sweep: clear every column (block RAM has no reset).
@@ -287,6 +307,17 @@ module de_span_array
       col_d   = col_q + 1'b1;
       if (col_q == CW'(NumCols - 1)) begin
         scrub_d = 1'b0;
+      end
+    end else if (run_q && cur_q.rfr) begin
+      // Refresh: the engine goes on in the other bank, which the last drain left clear,
+      // as soon as that drain is done; this line's bank is drained once every token
+      // before this one has written it back (the token reaching write back says so).
+      if (!drain_busy) begin
+        iss.vld   = 1'b1;
+        iss.last  = 1'b1;
+        bank_d    = !bank_q;
+        run_d     = 1'b0;
+        iss_cnt_d = iss_cnt_q + 1'b1;
       end
     end else if (run_q) begin
       if (cur_q.nul || !hazard) begin
@@ -312,7 +343,7 @@ module de_span_array
       cur_d.nslot = hr.nslot;
       if (hr.rfr) begin
         col_d  = '0;
-        end_d  = CW'(NumCols);
+        end_d  = '0;
         step_d = CW'(1);
       end else if (hr.per) begin
         // Period dX; dX = 0 reloads the countdown with 4095: period 4096 (isa.md 5).
@@ -325,13 +356,19 @@ module de_span_array
                                                         : CW'(NumCols);
         step_d = CW'(1);
       end
+      // A pass that touches no column (and the Refresh token) issues one token that
+      // only retires the table entry, so passes retire in order.
       cur_d.nul = (col_d >= end_d);
     end
   end
 
   // ==== pipeline ===========================================================================
-  logic [StW-1:0] ram [NumCols];
-  st_t  rd_q;                          // column state read in the issue clock
+  // Two banks of column state: the engine works in one while the other, holding the
+  // previous line, is drained (pixels out, cleared) by its own ports.
+  logic [StW-1:0] ram0 [NumCols];
+  logic [StW-1:0] ram1 [NumCols];
+  st_t  rd0_q, rd1_q, rd_q;            // state read in the previous clock, per bank
+  assign rd_q = tok_q[0].bank ? rd1_q : rd0_q;
   st_t  st_q [1:K + 1];                // st_q[s]: state entering stage s
   logic [DataW-1:0] cv_d [1:K], cv_q [1:K];  // per stage: value out of the last column
   st_t  st_s [1:K + 1];                // stage outputs (st_s[s] -> st_q[s])
@@ -339,16 +376,20 @@ module de_span_array
   logic [PixW-1:0] pix_d, pix_q;
   logic [11:0] pixc_d, pixc_q;
 
+  // Drain: after a Refresh token has reached write back, read the old bank column by
+  // column, send D[35:24] out and write the column back cleared a clock later.
+  logic          dpend_d, dpend_q, drun_d, drun_q, dbank_d, dbank_q, dclr_d, dclr_q;
+  logic          dwr_d, dwr_q;         // a drain read was issued last clock
+  logic [AW-1:0] dcol_d, dcol_q, dcol_q2;
+  logic [PixW-1:0] dpix;
+  assign dpix       = dbank_q ? rd1_q.d[DataW-1 -: PixW] : rd0_q.d[DataW-1 -: PixW];
+  assign drain_busy = dpend_q || drun_q || dwr_q;
+
   // Stage 0: the address slot's own effect and Refresh.
   always_comb begin
     st_s[1] = rd_q;
-    pixv_d  = 1'b0;
-    pix_d   = '0;
-    pixc_d  = 12'(tok_q[0].col);
     if (tok_q[0].vld && !tok_q[0].nul) begin
-      if (tok_q[0].rfr || tok_q[0].clr) begin
-        pixv_d  = tok_q[0].rfr;
-        pix_d   = rd_q.d[DataW-1 -: PixW];
+      if (tok_q[0].clr) begin
         st_s[1] = '0;
       end else if (tok_q[0].eff == EffEval0) begin
         if (!rd_q.lock && !rd_q.dis) begin
@@ -372,17 +413,18 @@ module de_span_array
     logic [DataW-1:0] vin, v, sum;
     logic  prot;
     st_t   st;
-    assign sl = slot_mem[s - 1][tok_q[s].ptr];
-    assign on = tok_q[s].vld && !tok_q[s].nul && !tok_q[s].clr && !tok_q[s].rfr &&
+    assign sl = slot_q[s - 1];
+    assign on = tok_q[s].vld && !tok_q[s].nul && !tok_q[s].clr &&
                 (tok_q[s].nslot > 4'(s - 1));
     // The first column of a pass gets the slot's own value; inactive columns between
     // active ones pass values unchanged, so every later column gets its left neighbour's.
     assign vin  = tok_q[s].first ? sl.val : cv_q[s];
-    assign prot = sl.prot && flag_of(st_q[s], sl.dst);
-    assign v    = prot ? reg_of(st_q[s], sl.dst) : vin;
+    assign prot = sl.prot && flag_of(st_q[s].pa, st_q[s].pb, st_q[s].pc, sl.dst);
+    assign v    = prot ? reg_of(st_q[s].a, st_q[s].b, st_q[s].c, sl.dst) : vin;
     // One adder per stage: D + A for ACC, the value plus SRC (read before DST is written)
     // for a data slot.
-    assign sum  = sl.acc ? add36(st_q[s].d, st_q[s].a) : add36(v, reg_of(st_q[s], sl.src));
+    assign sum  = sl.acc ? add36(st_q[s].d, st_q[s].a)
+                         : add36(v, reg_of(st_q[s].a, st_q[s].b, st_q[s].c, sl.src));
 
     always_comb begin
       st      = st_q[s];
@@ -390,19 +432,19 @@ module de_span_array
       if (on && !sl.acc) begin
         if (sl.set) begin
           cv_d[s] = vin;
-          case (sl.dst)
+          unique case (sl.dst)
             RegA: begin st.a = vin; st.pa = 1'b1; end
             RegB: begin st.b = vin; st.pb = 1'b1; end
             RegC: begin st.c = vin; st.pc = 1'b1; end
-            default: ;
+            RegNone: ;
           endcase
         end else begin
           cv_d[s] = sum;
-          case (sl.dst)
+          unique case (sl.dst)
             RegA:    st.a = v;
             RegB:    st.b = v;
             RegC:    st.c = v;
-            default: ;
+            RegNone: ;
           endcase
         end
       end
@@ -421,21 +463,94 @@ module de_span_array
   end
 
   // Write back, and retire the pass with its last token.
-  tok_t wb;
-  assign wb = tok_q[K + 1];
+  logic wb_vld, wb_we, wb_last, wb_bank, wb_rfr;
+  logic [AW-1:0] wb_col;
+  assign wb_vld  = tok_q[K + 1].vld;
+  assign wb_we   = wb_vld && !tok_q[K + 1].nul;
+  assign wb_last = tok_q[K + 1].last;
+  assign wb_col  = AW'(tok_q[K + 1].col);
+  assign wb_bank = tok_q[K + 1].bank;
+  assign wb_rfr  = wb_vld && tok_q[K + 1].rfr;
+
+  always_comb begin
+    dpend_d = dpend_q;
+    drun_d  = drun_q;
+    dbank_d = dbank_q;
+    dclr_d  = dclr_q;
+    dcol_d  = dcol_q;
+    dwr_d   = drun_q;
+    if (iss.vld && iss.rfr) begin
+      dpend_d = 1'b1;
+    end
+    if (wb_rfr) begin
+      dpend_d = 1'b0;
+      drun_d  = 1'b1;
+      dbank_d = wb_bank;
+      dclr_d  = 1'b0;
+      dcol_d  = '0;
+    end
+    if (drun_q) begin
+      dcol_d = dcol_q + 1'b1;
+      if (dcol_q == AW'(NumCols - 1)) begin
+        drun_d = 1'b0;
+      end
+    end
+    pixv_d = dwr_q && !dclr_q;
+    pix_d  = dpix;
+    pixc_d = 12'(dcol_q2);
+  end
+
+  // Port use per bank: the engine's tokens (tok bank) and the drain (dbank) never meet
+  // in one bank: the engine leaves a bank before the drain starts on it and enters it
+  // only after the drain has finished.
+  logic re0, re1, we0, we1;
+  logic [AW-1:0] ra0, ra1, wa0, wa1;
+  logic [StW-1:0] wd0, wd1;
+  always_comb begin
+    re0 = iss.vld && !iss.nul && !iss.bank;
+    re1 = iss.vld && !iss.nul && iss.bank;
+    ra0 = AW'(iss.col);
+    ra1 = AW'(iss.col);
+    we0 = wb_we && !wb_bank;
+    we1 = wb_we && wb_bank;
+    wa0 = wb_col;
+    wa1 = wb_col;
+    wd0 = StW'(st_q[K + 1]);
+    wd1 = StW'(st_q[K + 1]);
+    if (drun_q) begin
+      re0 = re0 || !dbank_q;
+      re1 = re1 || dbank_q;
+      if (!dbank_q) ra0 = dcol_q; else ra1 = dcol_q;
+    end
+    if (dwr_q) begin
+      if (!dbank_q) begin
+        we0 = 1'b1; wa0 = dcol_q2; wd0 = '0;
+      end else begin
+        we1 = 1'b1; wa1 = dcol_q2; wd1 = '0;
+      end
+    end
+  end
   always_comb begin
     ret_cnt_d = ret_cnt_q;
-    if (wb.vld && wb.last) begin
+    if (wb_vld && wb_last) begin
       ret_cnt_d = ret_cnt_q + 1'b1;
     end
   end
 
   always_ff @(posedge clk_i) begin
-    if (iss.vld && !iss.nul) begin
-      rd_q <= st_t'(ram[AW'(iss.col)]);
+    if (re0) begin
+      rd0_q <= st_t'(ram0[ra0]);
     end
-    if (wb.vld && !wb.nul) begin
-      ram[AW'(wb.col)] <= StW'(st_q[K + 1]);
+    if (we0) begin
+      ram0[wa0] <= wd0;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    if (re1) begin
+      rd1_q <= st_t'(ram1[ra1]);
+    end
+    if (we1) begin
+      ram1[wa1] <= wd1;
     end
   end
 
@@ -455,6 +570,15 @@ module de_span_array
       ret_cnt_q <= '0;
       run_q     <= 1'b0;
       scrub_q   <= 1'b1;
+      bank_q    <= 1'b0;
+      // Reset: the scrub clears bank 0 through the pipeline, the drain clears bank 1.
+      dpend_q   <= 1'b0;
+      drun_q    <= 1'b1;
+      dbank_q   <= 1'b1;
+      dclr_q    <= 1'b1;
+      dwr_q     <= 1'b0;
+      dcol_q    <= '0;
+      dcol_q2   <= '0;
       col_q     <= '0;
       end_q     <= '0;
       step_q    <= '0;
@@ -479,6 +603,14 @@ module de_span_array
       ret_cnt_q <= ret_cnt_d;
       run_q     <= run_d;
       scrub_q   <= scrub_d;
+      bank_q    <= bank_d;
+      dpend_q   <= dpend_d;
+      drun_q    <= drun_d;
+      dbank_q   <= dbank_d;
+      dclr_q    <= dclr_d;
+      dwr_q     <= dwr_d;
+      dcol_q    <= dcol_d;
+      dcol_q2   <= dcol_q;
       col_q     <= col_d;
       end_q     <= end_d;
       step_q    <= step_d;
@@ -506,7 +638,7 @@ module de_span_array
   assign pixel_valid_o = pixv_q;
   assign pixel_o       = pix_q;
   assign pixel_col_o   = pixc_q;
-  assign busy_o        = scrub_q || run_q || (wr_cnt_q != ret_cnt_q) ||
+  assign busy_o        = scrub_q || run_q || drain_busy || (wr_cnt_q != ret_cnt_q) ||
                          (iss_cnt_q != wr_cnt_q);
 
 endmodule

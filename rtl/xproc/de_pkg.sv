@@ -75,6 +75,9 @@ package de_pkg;
   // Width of de_pe's debug vector dbg_o; its layout is DBG_FIELDS in
   // sw/diffengine/structural.py (4x36 registers, 7 flags, 2x12 ids, 36 out, 12 pipeline
   // bits, pixel valid + 12).
+  // Modules without a de_pe (de_span_array) import the package but not this width.
+  /* verilator lint_off UNUSEDPARAM */
   localparam int unsigned DbgW = 4 * DataW + 7 + 2 * IdW + DataW + 12 + 1 + PixW;
+  /* verilator lint_on UNUSEDPARAM */
 
 endpackage

@@ -254,11 +254,40 @@ async def figure_lists(dut):
     b.check(cmds, bug())
 
 
+@cocotb.test(skip=not os.environ.get("DE_SPAN_STREAM"))
+async def stream_file(dut):
+    """A whole .de48 frame (DE_SPAN_STREAM) as fast as the array takes it: the frame must
+    equal the functional model, and the clocks each line took go to DE_SPAN_OUT (JSON)."""
+    import json
+    from diffengine import binfmt
+    path = Path(os.environ["DE_SPAN_STREAM"])
+    slots = binfmt.decode_de48(path.read_bytes(), str(path))
+    cmds = binfmt.deserialise(slots, str(path))
+    b = await start(dut)
+    t0 = b.cycle
+    await b.play(slots)
+    await b.drain()
+    b.check(cmds, bug())
+    ends = [t0] + b.refresh_cycles
+    per_line = [ends[i + 1] - ends[i] for i in range(len(ends) - 1)]
+    out = os.environ.get("DE_SPAN_OUT")
+    if out:
+        Path(out).write_text(json.dumps({"stream": str(path), "columns": b.n,
+                                         "max_slots": int(dut.MaxSlots.value),
+                                         "clocks_per_line": per_line,
+                                         "clocks_total": b.cycle - t0}) + "\n")
+    dut._log.info(f"{path.name}: {len(per_line)} lines equal the model; clocks per line "
+                  f"mean {sum(per_line) / len(per_line):.0f}, max {max(per_line)}")
+
+
 # ---- pytest runners ---------------------------------------------------------------------
 # (columns, slots per pass, carry bug): 37 columns (odd, not a power of two) with a pass
 # per Eval3; 2 slots per pass splits every Eval into 2-5 passes, with the carry fault;
 # 130 columns take the figure lists whole.
 RUNS = [(37, 4, 0), (37, 2, 1), (130, 9, 0)]
+if os.environ.get("DE_SPAN_STREAM"):   # scripts/bench_span.py: one full-width build
+    RUNS = [(int(os.environ.get("DE_SPAN_COLS", 648)),
+             int(os.environ.get("DE_SPAN_SLOTS", 4)), 0)]
 
 
 @pytest.mark.parametrize("cols,slots,bug", RUNS,
@@ -270,4 +299,5 @@ def test_de_span_array(cols, slots, bug):
                    [RTL / "xproc" / "de_pkg.sv", RTL / "varray" / "de_span_array.sv"],
                    "test_de_span_array",
                    parameters={"NumCols": cols, "MaxSlots": slots, "CarryBug": bug},
-                   extra_env={"DE_CARRY_BUG": str(bug)})
+                   extra_env={"DE_CARRY_BUG": str(bug)},
+                   testcase="stream_file" if os.environ.get("DE_SPAN_STREAM") else None)
