@@ -28,9 +28,9 @@ ONE = 1 << isa.FRAC_BITS
 class Bench:
     """Driver and monitor around one de_span_array."""
 
-    def __init__(self, dut, idle: float = 0.0, seed: int = 0):
+    def __init__(self, dut, idle: float = 0.0, seed: int = 0, n: int | None = None):
         self.dut = dut
-        self.n = int(dut.NumCols.value)
+        self.n = n or int(dut.NumCols.value)   # a netlist has no parameters: give n
         self.idle = idle                 # probability of an idle clock between slots
         self.rng = random.Random(seed)
         self.pixels: list[tuple[int, int]] = []   # (column, pixel) in output order
@@ -122,10 +122,10 @@ def seed_of(dut) -> int:
     return seed
 
 
-async def start(dut, idle: float = 0.0, seed: int = 0) -> Bench:
+async def start(dut, idle: float = 0.0, seed: int = 0, n: int | None = None) -> Bench:
     cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
     await Timer(1, unit="ns")
-    b = Bench(dut, idle, seed)
+    b = Bench(dut, idle, seed, n)
     await b.reset()
     return b
 

