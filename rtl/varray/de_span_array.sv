@@ -95,7 +95,9 @@ module de_span_array
 
   localparam logic [1:0] EffNone = 2'd0, EffEval0 = 2'd1, EffDis = 2'd2;
 
-  tok_t tok_q [K + 2];                 // tok_q[s]: token in stage s (K+1: write back)
+  // Token stages: 0 block RAM read, 1 read data registered (stage 0 logic), s+1 slot
+  // stage s, K+2 write back.
+  tok_t tok_q [K + 3];
 
   // The prototype's adder, with its carry fault as an option (isa.md section 7): the
   // carry out of bit 23 enters the integer part at bit 25 instead of bit 24.
@@ -259,7 +261,7 @@ module de_span_array
       if (slot_we && (nslot_q == 4'(j))) begin
         mem[wr_ptr] <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
       end
-      slot_q[j] <= mem[tok_q[j].ptr];
+      slot_q[j] <= mem[tok_q[j + 1].ptr];
     end
   end
 
@@ -274,7 +276,7 @@ module de_span_array
 
   always_comb begin
     hazard = 1'b0;
-    for (int s = 0; s < K + 2; s++) begin
+    for (int s = 0; s < K + 3; s++) begin
       if (tok_q[s].vld && !tok_q[s].nul && (tok_q[s].col == col_q)) begin
         hazard = 1'b1;
       end
@@ -367,8 +369,10 @@ module de_span_array
   // previous line, is drained (pixels out, cleared) by its own ports.
   logic [StW-1:0] ram0 [NumCols];
   logic [StW-1:0] ram1 [NumCols];
-  st_t  rd0_q, rd1_q, rd_q;            // state read in the previous clock, per bank
-  assign rd_q = tok_q[0].bank ? rd1_q : rd0_q;
+  // Block RAM output, registered once more (the DP16KD output register: its clock-to-out
+  // without it was the critical path), then the bank mux.
+  st_t  rd0_q, rd1_q, rd0_q2, rd1_q2, rd_q;
+  assign rd_q = tok_q[1].bank ? rd1_q2 : rd0_q2;
   st_t  st_q [1:K + 1];                // st_q[s]: state entering stage s
   logic [DataW-1:0] cv_d [1:K], cv_q [1:K];  // per stage: value out of the last column
   st_t  st_s [1:K + 1];                // stage outputs (st_s[s] -> st_q[s])
@@ -379,28 +383,28 @@ module de_span_array
   // Drain: after a Refresh token has reached write back, read the old bank column by
   // column, send D[35:24] out and write the column back cleared a clock later.
   logic          dpend_d, dpend_q, drun_d, drun_q, dbank_d, dbank_q, dclr_d, dclr_q;
-  logic          dwr_d, dwr_q;         // a drain read was issued last clock
-  logic [AW-1:0] dcol_d, dcol_q, dcol_q2;
+  logic          dwr_d, dwr_q, dwr_q2; // a drain read was issued one / two clocks ago
+  logic [AW-1:0] dcol_d, dcol_q, dcol_q2, dcol_q3;
   logic [PixW-1:0] dpix;
-  assign dpix       = dbank_q ? rd1_q.d[DataW-1 -: PixW] : rd0_q.d[DataW-1 -: PixW];
-  assign drain_busy = dpend_q || drun_q || dwr_q;
+  assign dpix       = dbank_q ? rd1_q2.d[DataW-1 -: PixW] : rd0_q2.d[DataW-1 -: PixW];
+  assign drain_busy = dpend_q || drun_q || dwr_q || dwr_q2;
 
   // Stage 0: the address slot's own effect and Refresh.
   always_comb begin
     st_s[1] = rd_q;
-    if (tok_q[0].vld && !tok_q[0].nul) begin
-      if (tok_q[0].clr) begin
+    if (tok_q[1].vld && !tok_q[1].nul) begin
+      if (tok_q[1].clr) begin
         st_s[1] = '0;
-      end else if (tok_q[0].eff == EffEval0) begin
+      end else if (tok_q[1].eff == EffEval0) begin
         if (!rd_q.lock && !rd_q.dis) begin
-          st_s[1].d    = {tok_q[0].i12, 24'd0};
+          st_s[1].d    = {tok_q[1].i12, 24'd0};
           st_s[1].lock = 1'b1;
         end
         st_s[1].pa  = 1'b0;
         st_s[1].pb  = 1'b0;
         st_s[1].pc  = 1'b0;
         st_s[1].dis = 1'b0;
-      end else if (tok_q[0].eff == EffDis) begin
+      end else if (tok_q[1].eff == EffDis) begin
         st_s[1].dis = 1'b1;
       end
     end
@@ -414,11 +418,14 @@ module de_span_array
     logic  prot;
     st_t   st;
     assign sl = slot_q[s - 1];
-    assign on = tok_q[s].vld && !tok_q[s].nul && !tok_q[s].clr &&
-                (tok_q[s].nslot > 4'(s - 1));
+    logic  first, accm;
+    assign first = tok_q[s + 1].first;
+    assign accm  = tok_q[s + 1].accm;
+    assign on    = tok_q[s + 1].vld && !tok_q[s + 1].nul && !tok_q[s + 1].clr &&
+                   (tok_q[s + 1].nslot > 4'(s - 1));
     // The first column of a pass gets the slot's own value; inactive columns between
     // active ones pass values unchanged, so every later column gets its left neighbour's.
-    assign vin  = tok_q[s].first ? sl.val : cv_q[s];
+    assign vin  = first ? sl.val : cv_q[s];
     assign prot = sl.prot && flag_of(st_q[s].pa, st_q[s].pb, st_q[s].pc, sl.dst);
     assign v    = prot ? reg_of(st_q[s].a, st_q[s].b, st_q[s].c, sl.dst) : vin;
     // One adder per stage: D + A for ACC, the value plus SRC (read before DST is written)
@@ -450,7 +457,7 @@ module de_span_array
       end
       if (on && sl.acc) begin
         // Acc_mode drops a negative A (bit 35) from the sum.
-        if (!st_q[s].lock && !st_q[s].dis && !(tok_q[s].accm && st_q[s].a[DataW-1])) begin
+        if (!st_q[s].lock && !st_q[s].dis && !(accm && st_q[s].a[DataW-1])) begin
           st.d = sum;
         end
         st.pa  = 1'b0;
@@ -465,12 +472,12 @@ module de_span_array
   // Write back, and retire the pass with its last token.
   logic wb_vld, wb_we, wb_last, wb_bank, wb_rfr;
   logic [AW-1:0] wb_col;
-  assign wb_vld  = tok_q[K + 1].vld;
-  assign wb_we   = wb_vld && !tok_q[K + 1].nul;
-  assign wb_last = tok_q[K + 1].last;
-  assign wb_col  = AW'(tok_q[K + 1].col);
-  assign wb_bank = tok_q[K + 1].bank;
-  assign wb_rfr  = wb_vld && tok_q[K + 1].rfr;
+  assign wb_vld  = tok_q[K + 2].vld;
+  assign wb_we   = wb_vld && !tok_q[K + 2].nul;
+  assign wb_last = tok_q[K + 2].last;
+  assign wb_col  = AW'(tok_q[K + 2].col);
+  assign wb_bank = tok_q[K + 2].bank;
+  assign wb_rfr  = wb_vld && tok_q[K + 2].rfr;
 
   always_comb begin
     dpend_d = dpend_q;
@@ -495,9 +502,9 @@ module de_span_array
         drun_d = 1'b0;
       end
     end
-    pixv_d = dwr_q && !dclr_q;
+    pixv_d = dwr_q2 && !dclr_q;
     pix_d  = dpix;
-    pixc_d = 12'(dcol_q2);
+    pixc_d = 12'(dcol_q3);
   end
 
   // Port use per bank: the engine's tokens (tok bank) and the drain (dbank) never meet
@@ -506,11 +513,14 @@ module de_span_array
   logic re0, re1, we0, we1;
   logic [AW-1:0] ra0, ra1, wa0, wa1;
   logic [StW-1:0] wd0, wd1;
+  // The engine reads at its column register every clock, whether or not the token
+  // goes out (the data is used only under a valid token): the hazard check stays out
+  // of the block RAM's address and enable paths.
   always_comb begin
-    re0 = iss.vld && !iss.nul && !iss.bank;
-    re1 = iss.vld && !iss.nul && iss.bank;
-    ra0 = AW'(iss.col);
-    ra1 = AW'(iss.col);
+    re0 = 1'b1;
+    re1 = 1'b1;
+    ra0 = AW'(col_q);
+    ra1 = AW'(col_q);
     we0 = wb_we && !wb_bank;
     we1 = wb_we && wb_bank;
     wa0 = wb_col;
@@ -518,8 +528,6 @@ module de_span_array
     wd0 = StW'(st_q[K + 1]);
     wd1 = StW'(st_q[K + 1]);
     if (drun_q) begin
-      re0 = re0 || !dbank_q;
-      re1 = re1 || dbank_q;
       if (!dbank_q) ra0 = dcol_q; else ra1 = dcol_q;
     end
     if (dwr_q) begin
@@ -577,6 +585,8 @@ module de_span_array
       dbank_q   <= 1'b1;
       dclr_q    <= 1'b1;
       dwr_q     <= 1'b0;
+      dwr_q2    <= 1'b0;
+      dcol_q3   <= '0;
       dcol_q    <= '0;
       dcol_q2   <= '0;
       col_q     <= '0;
@@ -586,7 +596,7 @@ module de_span_array
       pixv_q    <= 1'b0;
       pix_q     <= '0;
       pixc_q    <= '0;
-      for (int s = 0; s < K + 2; s++) begin
+      for (int s = 0; s < K + 3; s++) begin
         tok_q[s] <= '0;
       end
     end else begin
@@ -609,6 +619,8 @@ module de_span_array
       dbank_q   <= dbank_d;
       dclr_q    <= dclr_d;
       dwr_q     <= dwr_d;
+      dwr_q2    <= dwr_q;
+      dcol_q3   <= dcol_q2;
       dcol_q    <= dcol_d;
       dcol_q2   <= dcol_q;
       col_q     <= col_d;
@@ -619,7 +631,7 @@ module de_span_array
       pix_q     <= pix_d;
       pixc_q    <= pixc_d;
       tok_q[0]  <= iss;
-      for (int s = 1; s < K + 2; s++) begin
+      for (int s = 1; s < K + 3; s++) begin
         tok_q[s] <= tok_q[s - 1];
       end
     end
@@ -627,6 +639,8 @@ module de_span_array
 
   // Datapath registers: no reset (the reset sweep defines the state before use).
   always_ff @(posedge clk_i) begin
+    rd0_q2 <= rd0_q;
+    rd1_q2 <= rd1_q;
     for (int s = 1; s <= K + 1; s++) begin
       st_q[s] <= st_s[s];
     end

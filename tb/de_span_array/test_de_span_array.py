@@ -78,6 +78,41 @@ class Bench:
                     break
             d.instr_valid_i.value = 0
 
+    async def play_paced(self, slots, rate: int, htotal: int):
+        """The display's bus: slot k of a line of `htotal` slots (Nops pad each line) is
+        due at clock k * rate. A slot the array does not take in time waits (in hardware:
+        a FIFO in front); returns the clocks at which each Refresh was due and the
+        largest backlog in slots."""
+        d = self.dut
+        due_refresh, backlog, k, base = [], 0, 0, self.cycle
+        line: list = []
+        lines = []
+        for ident, data in slots:
+            line.append((ident, data))
+            if ident == isa.REFRESH:
+                lines.append(line[:-1] + [(isa.NOP, 0)] * (htotal - len(line)) + [line[-1]])
+                line = []
+        for ln in lines:
+            assert len(ln) == htotal, f"a line of {len(ln)} slots: more than HTotal {htotal}"
+            for ident, data in ln:
+                while self.cycle < base + k * rate:
+                    await FallingEdge(d.clk_i)
+                backlog = max(backlog, k - (self.cycle - base) // rate)
+                if ident == isa.REFRESH:
+                    due_refresh.append(base + k * rate)
+                d.instr_valid_i.value = 1
+                d.ident_i.value = ident
+                d.data_i.value = data
+                while True:
+                    await ReadOnly()
+                    taken = int(d.instr_ready_o.value)
+                    await FallingEdge(d.clk_i)
+                    if taken:
+                        break
+                d.instr_valid_i.value = 0
+                k += 1
+        return due_refresh, backlog
+
     async def drain(self):
         d = self.dut
         await FallingEdge(d.clk_i)
@@ -263,21 +298,35 @@ async def stream_file(dut):
     path = Path(os.environ["DE_SPAN_STREAM"])
     slots = binfmt.decode_de48(path.read_bytes(), str(path))
     cmds = binfmt.deserialise(slots, str(path))
+    rate = int(os.environ.get("DE_SPAN_RATE", "0"))
     b = await start(dut)
+    while int(dut.busy_o.value):          # the reset sweep
+        await FallingEdge(dut.clk_i)
     t0 = b.cycle
-    await b.play(slots)
-    await b.drain()
+    res = {"stream": str(path), "columns": b.n, "max_slots": int(dut.MaxSlots.value)}
+    if rate:
+        # Paced like the display's bus: HTotal slots per line, one per `rate` clocks.
+        htotal = int(os.environ.get("DE_SPAN_HTOTAL", 800))
+        due, backlog = await b.play_paced(slots, rate, htotal)
+        await b.drain()
+        lag = [e - d for e, d in zip(b.refresh_cycles, due)]
+        res.update(rate=rate, htotal=htotal, backlog_slots=backlog,
+                   lag_clocks=lag)
+        msg = (f"paced at 1 slot / {rate} clocks: last pixel of a line at most {max(lag)} "
+               f"clocks after its Refresh was due, backlog at most {backlog} slots")
+    else:
+        await b.play(slots)
+        await b.drain()
+        ends = [t0] + b.refresh_cycles
+        per_line = [ends[i + 1] - ends[i] for i in range(len(ends) - 1)]
+        res.update(clocks_per_line=per_line, clocks_total=b.cycle - t0)
+        msg = (f"clocks per line mean {sum(per_line) / len(per_line):.0f}, "
+               f"max {max(per_line)}")
     b.check(cmds, bug())
-    ends = [t0] + b.refresh_cycles
-    per_line = [ends[i + 1] - ends[i] for i in range(len(ends) - 1)]
     out = os.environ.get("DE_SPAN_OUT")
     if out:
-        Path(out).write_text(json.dumps({"stream": str(path), "columns": b.n,
-                                         "max_slots": int(dut.MaxSlots.value),
-                                         "clocks_per_line": per_line,
-                                         "clocks_total": b.cycle - t0}) + "\n")
-    dut._log.info(f"{path.name}: {len(per_line)} lines equal the model; clocks per line "
-                  f"mean {sum(per_line) / len(per_line):.0f}, max {max(per_line)}")
+        Path(out).write_text(json.dumps(res) + "\n")
+    dut._log.info(f"{path.name}: {len(b.refresh_cycles)} lines equal the model; {msg}")
 
 
 # ---- pytest runners ---------------------------------------------------------------------
