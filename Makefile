@@ -15,7 +15,7 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: sim fuzz-hsr help setup demo demo-cmd anim bench-array fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: sim fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
@@ -31,12 +31,13 @@ help:
 	@echo "                 (docs/performance.md)"
 	@echo "make bench-hsr   HSR benchmarks (Table 5.2, Fig 5.30) into docs/performance.md"
 	@echo "make bench-array Verilated array speed (1/8/72 chips) vs the models"
+	@echo "make bench-span  span-serial array: clocks per line on the teapot and CAD frames"
 	@echo "make waves TEST=<cocotb test> [PE=p] [BUG=0|1]"
 	@echo "                 FST + GTKWave save file for one PE (docs/debugging.md)"
 	@echo "make lint        verilator -Wall and verible lint on every RTL file"
-	@echo "make fpga        yosys + nextpnr: 9-PE chip on ECP5 and iCE40, 640-PE fit, virtual"
-	@echo "                 array, ULX3S board bitstream (fpga/, docs/fpga.md, docs/board.md);"
-	@echo "                 exits 1 today: the virtual array misses its timing gate (docs/fpga.md)"
+	@echo "make fpga        yosys + nextpnr: 9-PE chip on ECP5 and iCE40, 640-PE fit, span-serial"
+	@echo "                 array (3 x 648 columns), ULX3S board bitstream (fpga/, docs/fpga.md,"
+	@echo "                 docs/board.md); the folded virtual array: make -C fpga varray"
 	@echo "make fpga-board  only the ULX3S bitstream (fpga/ulx3s)"
 	@echo "make postsynth   yosys netlists simulated in Icarus against the golden model"
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
@@ -115,6 +116,9 @@ bench: $(SETUP)
 
 bench-array: $(SETUP)
 	$(ENV) $(PY) scripts/bench_array.py --write
+
+bench-span: $(SETUP)
+	$(ENV) $(PY) scripts/bench_span.py --write
 
 fpga-board: $(SETUP)
 	$(MAKE) -C fpga/ulx3s
