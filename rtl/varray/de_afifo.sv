@@ -1,0 +1,82 @@
+// Dual-clock FIFO: Gray-coded pointers, each synchronised into the other clock domain
+// through two flip-flops, storage in distributed RAM written in the write domain.
+//
+// The read side sees a word only after its write pointer has crossed (2-3 read clocks
+// after the write), and the memory cell was written before the pointer moved, so the
+// asynchronous read is stable. Full and empty are conservative (a pointer seen late
+// only delays a write or a read). Reset: each side has its own synchronous reset; both
+// must be held together for a few clocks of the slower domain.
+module de_afifo #(
+  parameter int unsigned W  = 48,
+  parameter int unsigned AW = 4           // 2^AW words
+) (
+  input  logic         wclk_i,
+  input  logic         wrst_i,
+  input  logic         wvalid_i,
+  input  logic [W-1:0] wdata_i,
+  output logic         wfull_o,
+  input  logic         rclk_i,
+  input  logic         rrst_i,
+  output logic         rvalid_o,
+  input  logic         rready_i,
+  output logic [W-1:0] rdata_o
+);
+  if (AW < 2 || AW > 10) begin : g_bad_aw
+    $fatal(1, "de_afifo: AW must be 2..10, got %0d", AW);
+  end
+
+  function automatic logic [AW:0] bin2gray(input logic [AW:0] b);
+    return b ^ (b >> 1);
+  endfunction
+
+  logic [W-1:0] mem [1 << AW];
+
+  // ---- write domain ----
+  logic [AW:0] wbin_d, wbin_q, wgray_q, rgray_w1_q, rgray_w2_q;
+  logic        wen;
+  // Full: the write pointer is one lap ahead of the read pointer (Gray form: the two
+  // top bits differ, the rest agree).
+  assign wfull_o = (wgray_q == {~rgray_w2_q[AW:AW-1], rgray_w2_q[AW-2:0]});
+  assign wen     = wvalid_i && !wfull_o;
+  assign wbin_d  = wbin_q + (AW + 1)'(wen);
+
+  always_ff @(posedge wclk_i) begin
+    if (wen) begin
+      mem[wbin_q[AW-1:0]] <= wdata_i;
+    end
+  end
+
+  always_ff @(posedge wclk_i) begin
+    if (wrst_i) begin
+      wbin_q     <= '0;
+      wgray_q    <= '0;
+      rgray_w1_q <= '0;
+      rgray_w2_q <= '0;
+    end else begin
+      wbin_q     <= wbin_d;
+      wgray_q    <= bin2gray(wbin_d);
+      rgray_w1_q <= rgray_q;
+      rgray_w2_q <= rgray_w1_q;
+    end
+  end
+
+  // ---- read domain ----
+  logic [AW:0] rbin_d, rbin_q, rgray_q, wgray_r1_q, wgray_r2_q;
+  assign rvalid_o = (rgray_q != wgray_r2_q);
+  assign rdata_o  = mem[rbin_q[AW-1:0]];
+  assign rbin_d   = rbin_q + (AW + 1)'(rvalid_o && rready_i);
+
+  always_ff @(posedge rclk_i) begin
+    if (rrst_i) begin
+      rbin_q     <= '0;
+      rgray_q    <= '0;
+      wgray_r1_q <= '0;
+      wgray_r2_q <= '0;
+    end else begin
+      rbin_q     <= rbin_d;
+      rgray_q    <= bin2gray(rbin_d);
+      wgray_r1_q <= wgray_q;
+      wgray_r2_q <= wgray_r1_q;
+    end
+  end
+endmodule

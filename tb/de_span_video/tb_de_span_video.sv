@@ -1,0 +1,40 @@
+// Testbench top: the plain array and the span-serial array behind its pixel-bus
+// contract, side by side on one instruction bus (tb/de_span_video).
+module tb_de_span_video #(
+  parameter int unsigned NumChips = 2,
+  parameter int unsigned Latency  = 60,
+  parameter int unsigned CarryBug = 0
+) (
+  input  logic        clk_i,
+  input  logic        clk_core_i,
+  input  logic        rst_i,
+  input  logic [11:0] ident_i,
+  input  logic [35:0] data_i,
+  output logic        a_pixel_valid_o,
+  output logic [11:0] a_pixel_o,
+  output logic        s_pixel_valid_o,
+  output logic [11:0] s_pixel_o,
+  output logic        late_o,
+  output logic        overflow_o
+);
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [11:0] ident_out;
+  logic [35:0] data_out;
+  logic [15:0] n_pe;
+  logic        coll, cfg_o, obs_o;
+  /* verilator lint_on UNUSEDSIGNAL */
+
+  de_array #(.NumChips(NumChips), .CarryBug(CarryBug)) u_array (
+    .clk_i, .rst_i, .ident_i, .data_i,
+    .ident_o(ident_out), .data_o(data_out),
+    .pixel_valid_o(a_pixel_valid_o), .pixel_o(a_pixel_o), .n_pe_o(n_pe),
+    .pix_collision_o(coll), .cfg_mode_i(1'b0), .cfg_bit_i(1'b0), .cfg_bit_o(cfg_o),
+    .obs_load_i(1'b0), .obs_shift_i(1'b0), .obs_bit_o(obs_o)
+  );
+
+  de_span_video #(.NumCols(9 * NumChips), .CarryBug(CarryBug), .Latency(Latency),
+                  .NumLineBuf(8)) u_span (
+    .clk_i, .rst_i, .clk_core_i, .ident_i, .data_i,
+    .pixel_valid_o(s_pixel_valid_o), .pixel_o(s_pixel_o), .late_o, .overflow_o
+  );
+endmodule
