@@ -163,7 +163,8 @@ module de_board_core #(
     .TestVSync  (TestVSync),
     .TestVBp    (TestVBp)
   ) u_dc (
-    .clk_i, .rst_i, .mode_i,
+    // The board carries the plain arrays (SpanArray = 0): no core clock.
+    .clk_i, .rst_i, .clk_core_i(clk_i), .mode_i,
     .wr_valid_i     (wr_valid),
     .wr_ready_o     (wr_ready),
     .wr_data_i      (wr_data),

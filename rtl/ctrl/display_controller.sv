@@ -12,6 +12,12 @@
 // line leave each array NumChips + 3 cycles after its Refresh is on the bus
 // (docs/array.md), which sets the sync/blank delay; the core adds one output register to
 // pixels and sync alike.
+//
+// SpanArray = 1 puts the span-serial array (rtl/varray/de_span_video.sv: 9 * NumChips
+// columns in block RAM, running on clk_core_i, docs/fpga.md 3) in place of each de_array,
+// with SpanLatency pixel clocks from Refresh to column 0. Its late/overflow flags come
+// out on pix_collision_o; it has no bypass or observation chain (cfg_bit_o = cfg_bit_i,
+// obs_bit_o = 0). With SpanArray = 0, clk_core_i is not used.
 module display_controller #(
   parameter int unsigned NumChips    = 72,   // 648 PEs per colour (640 columns + spares)
   parameter int unsigned CarryBug    = 0,    // §7.7 fault in every PE (all three arrays)
@@ -29,13 +35,19 @@ module display_controller #(
   parameter int unsigned TestVFp     = 1,
   parameter int unsigned TestVSync   = 2,
   parameter int unsigned TestVBp     = 2,
+  parameter int unsigned SpanArray   = 0,
+  parameter int unsigned SpanLatency = 300,
   // docs/array.md: a Refresh on ident_i in the cycle ending with edge E puts column q on
   // pixel_o right after edge E + NumChips + 2 + q, i.e. NumChips + 3 cycles later.
-  localparam int unsigned ArrayLatency = NumChips + 3,
+  localparam int unsigned ArrayLatency = SpanArray != 0 ? SpanLatency : NumChips + 3,
   localparam int unsigned NumCh        = 3
 ) (
   input  logic                                 clk_i,
   input  logic                                 rst_i,
+  // The span-serial arrays' core clock (SpanArray = 1 only).
+  /* verilator lint_off UNUSEDSIGNAL */
+  input  logic                                 clk_core_i,
+  /* verilator lint_on UNUSEDSIGNAL */
   input  logic [1:0]                           mode_i,
   // y-processor write ports: [channel 0 = R, 1 = G, 2 = B][y-processor].
   input  logic [NumCh-1:0][NumBuf-1:0]         wr_valid_i,
@@ -118,7 +130,32 @@ module display_controller #(
     .align_err_o
   );
 
+  if (SpanArray > 1) begin : gen_err_span
+    $error("display_controller: SpanArray must be 0 or 1");
+  end
+
   for (genvar c = 0; c < NumCh; c++) begin : g_arr
+   if (SpanArray != 0) begin : g_span
+    logic late, overflow;
+    de_span_video #(
+      .NumCols (9 * NumChips),
+      .CarryBug(CarryBug),
+      .Latency (SpanLatency)
+    ) u_array (
+      .clk_i,
+      .rst_i,
+      .clk_core_i,
+      .ident_i      (instr[c][47:36]),
+      .data_i       (instr[c][35:0]),
+      .pixel_valid_o(pix_valid[c]),
+      .pixel_o      (pix[c]),
+      .late_o       (late),
+      .overflow_o   (overflow)
+    );
+    assign pix_collision_o[c] = late || overflow;
+    assign cfg_bit_o[c]       = cfg_bit_i[c];
+    assign obs_bit_o[c]       = 1'b0;
+   end else begin : g_plain
     // The array's pass-through bus (for chaining virtual arrays) and its PE count are
     // not needed here.
     /* verilator lint_off UNUSEDSIGNAL */
@@ -148,6 +185,7 @@ module display_controller #(
       .obs_shift_i,
       .obs_bit_o      (obs_bit_o[c])
     );
+   end
   end
 
 endmodule

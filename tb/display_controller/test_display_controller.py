@@ -56,6 +56,8 @@ def geom(dut):
     g["HTotal"] = g["TestHActive"] + g["TestHFp"] + g["TestHSync"] + g["TestHBp"]
     g["VTotal"] = g["TestVActive"] + g["TestVFp"] + g["TestVSync"] + g["TestVBp"]
     g["n_pe"] = 9 * g["NumChips"]
+    g["SpanArray"] = int(dut.SpanArray.value)
+    g["ArrayLatency"] = int(dut.SpanLatency.value) if g["SpanArray"] else g["NumChips"] + 3
     return g
 
 
@@ -355,6 +357,10 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
     dut._log.info(f"SEED={seed}")
     g = geom(dut)
     cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
+    if g["SpanArray"]:
+        # The span-serial arrays' core clock: unrelated phase, ~16.7x (the test lines are
+        # short, 24 slots, and the random spans long for them).
+        cocotb.start_soon(Clock(dut.clk_core_i, 600, unit="ps").start())
     n_lines = frames * g["TestVActive"]
     streams = make_streams(seed, g, n_lines, per_line, max_words)
     bench = Bench(dut, g, streams, stall_p, seed, skip_late)
@@ -413,7 +419,7 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
     n = check_video(bench, gold, w8, sat8)
 
     # ---- Load Monitor read-out vs the buses ---------------------------------------
-    assert info == (0xDC << 24) | (3 << 20) | (g["NumBuf"] << 16) | (g["NumChips"] + 3)
+    assert info == (0xDC << 24) | (3 << 20) | (g["NumBuf"] << 16) | g["ArrayLatency"]
     nbins, shift = int(dut.NumBins.value), int(dut.BinShift.value)
     util = []
     total_late_lines = 0
@@ -532,6 +538,10 @@ RUNS = {
     "busy800": dict(NumChips=1, CarryBug=0, NumBuf=4, BufDepth=16, NumBins=16,
                     BinShift=7, MaxLines=16, TestHActive=9, TestHFp=16, TestHSync=96,
                     TestHBp=679, TestVActive=16, TestVFp=1, TestVSync=2, TestVBp=2),
+    # The span-serial array (docs/fpga.md 3) in place of each de_array: 18 columns in
+    # block RAM on its own clock, pixels 30 pixel clocks after the Refresh.
+    "span_chips2": dict(NumChips=2, CarryBug=0, NumBuf=2, BufDepth=32, NumBins=4,
+                        BinShift=3, MaxLines=8, SpanArray=1, SpanLatency=30),
 }
 
 
@@ -543,7 +553,9 @@ def test_display_controller(name):
             RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv",
             RTL / "ctrl" / "de_instr_buffer.sv", RTL / "ctrl" / "de_video_timing.sv",
             RTL / "ctrl" / "de_access_ctrl.sv", RTL / "ctrl" / "de_load_monitor.sv",
-            RTL / "ctrl" / "de_display_core.sv", RTL / "ctrl" / "display_controller.sv"]
+            RTL / "ctrl" / "de_display_core.sv", RTL / "ctrl" / "display_controller.sv",
+            RTL / "varray" / "de_span_array.sv", RTL / "varray" / "de_afifo.sv",
+            RTL / "varray" / "de_span_video.sv"]
     build_and_test(HERE, "display_controller", srcs, "test_display_controller",
                    parameters=RUNS[name],
                    extra_env={"DE_UTIL_OUT": str(HERE / "sim_build_util" / f"{name}.txt")})
