@@ -15,13 +15,15 @@ import re
 import sys
 from pathlib import Path
 
-NOMINAL = {"pixel": 25.175, "shift": 5 * 25.175}
+NOMINAL = {"pixel": 25.175, "shift": 5 * 25.175, "core": 78.125}
 DEVICE = {"LUT4": 83640, "TRELLIS_FF": 83640, "DP16KD": 208, "MULT18X18D": 156}
 
 
 def domain(name: str) -> str:
     if "shift" in name:
         return "shift"
+    if "core" in name:
+        return "core"
     if "pix" in name:
         return "pixel"
     return name
@@ -35,6 +37,7 @@ def main() -> int:
     ap.add_argument("--num-chips", type=int, required=True)
     ap.add_argument("--fs-depth", type=int, required=True)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--span", type=int, default=0)
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
 
@@ -45,7 +48,9 @@ def main() -> int:
     tool = re.findall(r"nextpnr-\S+", log[:400])
 
     lines = [f"Difference Engine board top on ULX3S (LFE5U-85F-6 CABGA381) - make -C fpga/ulx3s",
-             f"configuration: NumChips {a.num_chips} per colour ({9 * a.num_chips} PEs x 3 colours), "
+             (f"configuration: span-serial arrays, {9 * a.num_chips} columns x 3 colours on the "
+              "78.125 MHz core clock, " if a.span else
+              f"configuration: NumChips {a.num_chips} per colour ({9 * a.num_chips} PEs x 3 colours), ") +
              f"frame store {a.fs_depth} words x 3 colours, NumBuf 1, BufDepth 16, mode 0 "
              f"(640x480 timing, 25.0 MHz pixel clock)",
              f"nextpnr seed {a.seed}", "",
@@ -85,6 +90,7 @@ def main() -> int:
     out.with_suffix(".txt").write_text(text)
     out.with_suffix(".json").write_text(json.dumps(
         {"num_chips": a.num_chips, "fs_depth": a.fs_depth, "seed": a.seed, "tool": tool,
+         "span": a.span,
          "synth_cells": syn, "placed": util, "clocks": clocks, "pass": ok}, indent=1) + "\n")
     return 0 if ok else 1
 

@@ -3,6 +3,9 @@
 //
 //   clk_25mhz -> EHXPLLL (VCO 625 MHz) -> CLKOP 125 MHz (TMDS DDR bit clock, 5x)
 //                                      -> CLKOS  25 MHz (pixel clock)
+//                                      -> CLKOS2 78.125 MHz (span-serial arrays' core
+//                                         clock, SpanArray = 1: 625 / 8; the arrays'
+//                                         FIFOs make the ratio to the pixel clock free)
 //   btn[1] (FIRE1) or PLL not locked -> synchronous reset of the pixel domain
 //   ftdi_txd (FPGA receives) / ftdi_rxd (FPGA transmits): the loader's UART
 //   gpdi_dp[3:0]: TMDS blue/green/red/clock through ODDRX1F, 2 bits per 125 MHz clock;
@@ -24,11 +27,12 @@ module ulx3s_top (
   output logic [3:0] gpdi_dp
 );
   // ------------------------------------------------------------------ clocks
-  logic clk_shift, clk_pix, pll_locked;
+  logic clk_shift, clk_pix, clk_core, pll_locked;
 
   (* FREQUENCY_PIN_CLKI = "25" *)
   (* FREQUENCY_PIN_CLKOP = "125" *)
   (* FREQUENCY_PIN_CLKOS = "25" *)
+  (* FREQUENCY_PIN_CLKOS2 = "78.125" *)
   (* ICP_CURRENT = "12" *) (* LPF_RESISTOR = "8" *)
   (* MFG_ENABLE_FILTEROPAMP = "1" *) (* MFG_GMCREF_SEL = "2" *)
   EHXPLLL #(
@@ -50,13 +54,18 @@ module ulx3s_top (
     .CLKOS_ENABLE   ("ENABLED"),
     .CLKOS_DIV      (25),     // 25 MHz
     .CLKOS_CPHASE   (2),
-    .CLKOS_FPHASE   (0)
+    .CLKOS_FPHASE   (0),
+    .CLKOS2_ENABLE  ("ENABLED"),
+    .CLKOS2_DIV     (8),      // 78.125 MHz
+    .CLKOS2_CPHASE  (2),
+    .CLKOS2_FPHASE  (0)
   ) u_pll (
     .RST         (1'b0),
     .STDBY       (1'b0),
     .CLKI        (clk_25mhz),
     .CLKOP       (clk_shift),
     .CLKOS       (clk_pix),
+    .CLKOS2      (clk_core),
     .CLKFB       (clk_shift),
     .CLKINTFB    (),
     .PHASESEL0   (1'b0),
@@ -92,6 +101,7 @@ module ulx3s_top (
 
   de_board_core u_core (
     .clk_i    (clk_pix),
+    .clk_core_i(clk_core),
     .rst_i    (rst_pix),
     .mode_i   (2'd0),          // 640x480 timing (VESA DMT totals 800 x 525)
     .uart_rx_i(ftdi_txd),

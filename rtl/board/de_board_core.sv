@@ -6,8 +6,10 @@
 //                                                                          |
 //   tmds_o[2:0] <- de_tmds_enc x 3 <- rgb8 / hsync / vsync / blank <-------+
 //
-// One clock domain, the pixel clock (clk_i). The board shell (fpga/ulx3s/) adds the
-// PLL, the 10:1 serialisers and the pins. Colour: one frame store, one player and one
+// One clock domain, the pixel clock (clk_i), plus clk_core_i for the span-serial arrays
+// when SpanArray = 1 (9 * NumChips columns each in block RAM, docs/fpga.md 3; unused
+// otherwise). The board shell (fpga/ulx3s/) adds the PLL, the 10:1 serialisers and the
+// pins. Colour: one frame store, one player and one
 // instruction buffer per colour (the display controller's one-buffer-per-colour
 // choice, docs/display-controller.md §9.1); each player is the single y-processor of
 // its colour. TMDS channel 0 is blue and carries {VSYNC, HSYNC} as {C1, C0} while
@@ -28,9 +30,12 @@ module de_board_core #(
   parameter int unsigned TestVFp     = 1,
   parameter int unsigned TestVSync   = 2,
   parameter int unsigned TestVBp     = 2,
+  parameter int unsigned SpanArray   = 0,      // 1: span-serial arrays on clk_core_i
+  parameter int unsigned SpanLatency = 300,    // their Refresh -> column 0, pixel clocks
   localparam int unsigned AW = $clog2(FsDepth)
 ) (
   input  logic            clk_i,
+  input  logic            clk_core_i,
   input  logic            rst_i,
   input  logic [1:0]      mode_i,       // video mode (display-controller.md §3), in reset
   input  logic            uart_rx_i,
@@ -161,10 +166,11 @@ module de_board_core #(
     .TestVActive(TestVActive),
     .TestVFp    (TestVFp),
     .TestVSync  (TestVSync),
-    .TestVBp    (TestVBp)
+    .TestVBp    (TestVBp),
+    .SpanArray  (SpanArray),
+    .SpanLatency(SpanLatency)
   ) u_dc (
-    // The board carries the plain arrays (SpanArray = 0): no core clock.
-    .clk_i, .rst_i, .clk_core_i(clk_i), .mode_i,
+    .clk_i, .rst_i, .clk_core_i, .mode_i,
     .wr_valid_i     (wr_valid),
     .wr_ready_o     (wr_ready),
     .wr_data_i      (wr_data),

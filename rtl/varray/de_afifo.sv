@@ -30,9 +30,10 @@ module de_afifo #(
   endfunction
 
   logic [W-1:0] mem [1 << AW];
+  logic [AW:0] wgray_q, rgray_q;            // each side's pointer, Gray-coded
 
   // ---- write domain ----
-  logic [AW:0] wbin_d, wbin_q, wgray_q, rgray_w1_q, rgray_w2_q;
+  logic [AW:0] wbin_d, wbin_q, rgray_w1_q, rgray_w2_q;
   logic        wen;
   // Full: the write pointer is one lap ahead of the read pointer (Gray form: the two
   // top bits differ, the rest agree).
@@ -61,7 +62,7 @@ module de_afifo #(
   end
 
   // ---- read domain ----
-  logic [AW:0] rbin_d, rbin_q, rgray_q, wgray_r1_q, wgray_r2_q;
+  logic [AW:0] rbin_d, rbin_q, wgray_r1_q, wgray_r2_q;
   assign rvalid_o = (rgray_q != wgray_r2_q);
   assign rdata_o  = mem[rbin_q[AW-1:0]];
   assign rbin_d   = rbin_q + (AW + 1)'(rvalid_o && rready_i);

@@ -13,17 +13,20 @@ module EHXPLLL #(
   parameter string CLKOP_ENABLE = "", parameter int CLKOP_DIV = 1,
   parameter int CLKOP_CPHASE = 0, parameter int CLKOP_FPHASE = 0,
   parameter string CLKOS_ENABLE = "", parameter int CLKOS_DIV = 1,
-  parameter int CLKOS_CPHASE = 0, parameter int CLKOS_FPHASE = 0
+  parameter int CLKOS_CPHASE = 0, parameter int CLKOS_FPHASE = 0,
+  parameter string CLKOS2_ENABLE = "", parameter int CLKOS2_DIV = 1,
+  parameter int CLKOS2_CPHASE = 0, parameter int CLKOS2_FPHASE = 0
 ) (
   input  logic RST, STDBY, CLKI, CLKFB, PHASESEL0, PHASESEL1, PHASEDIR, PHASESTEP,
   input  logic PHASELOADREG, PLLWAKESYNC, ENCLKOP,
-  output logic CLKOP, CLKOS, CLKINTFB, LOCK
+  output logic CLKOP, CLKOS, CLKOS2, CLKINTFB, LOCK
 );
   logic clkop_r /* verilator public */;
   logic clkos_r /* verilator public */;
   logic lock_r  /* verilator public */;
   assign CLKOP = clkop_r;
   assign CLKOS = clkos_r;
+  assign CLKOS2 = clkos_r;      // the core default uses no core clock (SpanArray = 0)
   assign CLKINTFB = 1'b0;
   assign LOCK = lock_r;
 endmodule

@@ -321,6 +321,9 @@ class Video:
 
 async def reset(dut, g):
     cocotb.start_soon(Clock(dut.clk_i, 40, unit="ns").start())
+    if int(dut.SpanArray.value):
+        # The span-serial arrays' core clock, unrelated in phase to the pixel clock.
+        cocotb.start_soon(Clock(dut.clk_core_i, 3900, unit="ps").start())
     dut.rst_i.value = 1
     dut.mode_i.value = 3
     dut.uart_rx_i.value = 1
@@ -427,7 +430,8 @@ async def test_load_and_play(dut):
         r = await host.command(with_chk(b"R" + addr.to_bytes(2, "big")), n_reply=5)
         assert r[0] == ord("R"), r
         regs[name] = int.from_bytes(r[1:], "big")
-    assert regs["id"] == (0xDC << 24 | 3 << 20 | 1 << 16 | (g["NumChips"] + 3)), hex(regs["id"])
+    lat = int(dut.SpanLatency.value) if int(dut.SpanArray.value) else g["NumChips"] + 3
+    assert regs["id"] == (0xDC << 24 | 3 << 20 | 1 << 16 | lat), hex(regs["id"])
     for c in range(NCH):
         assert regs[f"late{c}"] == 0 and regs[f"drop{c}"] == 0, regs
     assert regs["frames0"] >= n_video - 1, regs
@@ -520,7 +524,8 @@ def board_sources():
         "ctrl/de_access_ctrl.sv", "ctrl/de_load_monitor.sv", "ctrl/de_display_core.sv",
         "ctrl/display_controller.sv", "board/de_uart_rx.sv", "board/de_uart_tx.sv",
         "board/de_loader.sv", "board/de_fs_player.sv", "board/de_tmds_enc.sv",
-        "board/de_board_core.sv")]
+        "board/de_board_core.sv", "varray/de_span_array.sv", "varray/de_afifo.sv",
+        "varray/de_span_video.sv")]
 
 
 def test_tmds():
@@ -529,10 +534,14 @@ def test_tmds():
                    "test_board_top", testcase="test_tmds_encoder")
 
 
-def test_board():
+@pytest.mark.parametrize("span", [0, 1], ids=["plain", "span"])
+def test_board(span):
+    """span = 1: the span-serial arrays (docs/fpga.md 3) in place of the plain ones, on a
+    core clock ~10x the pixel clock (the test lines are 17 slots long)."""
     from common.run import build_and_test
+    params = dict(BOARD, SpanArray=1, SpanLatency=18) if span else BOARD
     build_and_test(HERE, "de_board_core", board_sources(), "test_board_top",
-                   parameters=BOARD, testcase="test_load_and_play")
+                   parameters=params, testcase="test_load_and_play")
 
 
 def test_shell():
