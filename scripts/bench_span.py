@@ -128,6 +128,21 @@ def write_doc(rows: list, ratio: int) -> None:
             f"{sum(c) / len(c):,.0f} / {max(c):,} | {100 * max(c) / (ratio * 800):.0f} % | "
             f"{max(lag)} ({max(lag) / ratio:.0f} px) | {p['backlog_slots']} | "
             f"{plain_ops / (sum(c) / len(c)):.0f}x |")
+    ok = [r["scene"] for r in rows if r["paced"]["backlog_slots"] == 0]
+    bad = [r for r in rows if r["paced"]["backlog_slots"] > 0]
+    verdict = ""
+    if ok:
+        verdict += (f"Paced at the bus rate the array keeps up with every line of "
+                    f"{', '.join(sorted(set(ok)))}: no slot waits, and each line's last pixel "
+                    f"is out within the lag above of its Refresh. ")
+    for sc in sorted({r["scene"] for r in bad}):
+        rs = [r for r in bad if r["scene"] == sc]
+        verdict += (f"On {sc} a band of lines needs more than the line period: the array "
+                    f"falls up to {max(r['paced']['backlog_slots'] for r in rs)} slots behind "
+                    f"the bus and a line's last pixel comes up to "
+                    f"{max(max(r['paced']['lag_clocks']) for r in rs)} clocks after its "
+                    f"Refresh; a display path (de_span_video) then needs a FIFO that deep "
+                    f"and a Latency that long, or a faster core clock. ")
     body = f"""{SECTION}
 
 Reproduce: `make bench-span` (`scripts/bench_span.py --write`, ~{len(rows) * 1} min). Each
@@ -148,11 +163,12 @@ last column gives its operations per line over the span array's clocks per line.
 
 ![core clocks per line](img/span_clocks.png)
 
-A line's work is its spans (one clock per column a command touches, ~950 per line on
-the teapot), one clock per pass and the in-flight stalls; the Refresh costs one clock
-(the old bank drains in parallel). Paced at the bus rate the array keeps up with every
-line of these frames: no slot waits, and a line's pixels are all out within the lag
-above of its Refresh, i.e. the drain starts within a few clocks of it.
+A line's work is its spans (one clock per column a command touches), one clock per
+pass and the in-flight stalls (a command that starts on a column the previous one has
+just visited waits up to 7 clocks for its write back); the Refresh costs one clock (the
+old bank drains in parallel).
+
+{verdict}
 """
     path = ROOT / "docs" / "performance.md"
     text = path.read_text()

@@ -97,7 +97,8 @@ class Bench:
             for ident, data in ln:
                 while self.cycle < base + k * rate:
                     await FallingEdge(d.clk_i)
-                backlog = max(backlog, k - (self.cycle - base) // rate)
+                # Slots due but not yet taken: how far the array is behind the bus.
+                backlog = max(backlog, (self.cycle - base) // rate - k)
                 if ident == isa.REFRESH:
                     due_refresh.append(base + k * rate)
                 d.instr_valid_i.value = 1
