@@ -24,7 +24,7 @@ module de_span_video
   parameter int unsigned CarryBug   = 0,
   parameter int unsigned Latency    = 300,  // pixel clocks, Refresh -> column 0
   parameter int unsigned NumLineBuf = 4,
-  parameter int unsigned FifoAw     = 5     // 32 slots between the clock domains
+  parameter int unsigned FifoAw     = 8     // 256 slots between the clock domains
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
