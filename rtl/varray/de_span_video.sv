@@ -57,8 +57,12 @@ module de_span_video
   assign is_refresh = ident_i[IdRefreshBit];
 
   logic rst_c1_q, rst_c2_q;                  // rst_i synchronised to the core clock
-  logic              cvalid, cready;
-  logic [IdW+DataW-1:0] cword;
+  logic              fvalid, fready, cready;
+  logic [IdW+DataW-1:0] fword;
+  // The FIFO's output (a read of its distributed RAM) is registered before the array:
+  // otherwise that read runs straight into the array's front-end decode.
+  logic              cvalid_d, cvalid_q;
+  logic [IdW+DataW-1:0] cword_d, cword_q;
 
   de_afifo #(.W(IdW + DataW), .AW(FifoAw)) u_fifo (
     .wclk_i  (clk_i),
@@ -68,10 +72,19 @@ module de_span_video
     .wfull_o (fifo_full),
     .rclk_i  (clk_core_i),
     .rrst_i  (rst_c2_q),
-    .rvalid_o(cvalid),
-    .rready_i(cready),
-    .rdata_o (cword)
+    .rvalid_o(fvalid),
+    .rready_i(fready),
+    .rdata_o (fword)
   );
+  assign fready = !cvalid_q || cready;
+  always_comb begin
+    cvalid_d = cvalid_q;
+    cword_d  = cword_q;
+    if (fready) begin
+      cvalid_d = fvalid;
+      cword_d  = fword;
+    end
+  end
   assign ovf_d = ovf_q || fifo_full;
 
   // ==== core clock: the array and the line buffer writes ==================================
@@ -83,10 +96,10 @@ module de_span_video
   de_span_array #(.NumCols(NumCols), .MaxSlots(MaxSlots), .CarryBug(CarryBug)) u_span (
     .clk_i        (clk_core_i),
     .rst_i        (rst_c2_q),
-    .instr_valid_i(cvalid),
+    .instr_valid_i(cvalid_q),
     .instr_ready_o(cready),
-    .ident_i      (cword[IdW+DataW-1 -: IdW]),
-    .data_i       (cword[DataW-1:0]),
+    .ident_i      (cword_q[IdW+DataW-1 -: IdW]),
+    .data_i       (cword_q[DataW-1:0]),
     .pixel_valid_o(cpix_valid),
     .pixel_o      (cpix),
     .pixel_col_o  (cpix_col),
@@ -108,12 +121,15 @@ module de_span_video
   always_ff @(posedge clk_core_i) begin
     rst_c1_q <= rst_i;
     rst_c2_q <= rst_c1_q;
+    cword_q  <= cword_d;
     if (rst_c2_q) begin
-      wline_q <= '0;
-      wgray_q <= '0;
+      wline_q  <= '0;
+      wgray_q  <= '0;
+      cvalid_q <= 1'b0;
     end else begin
-      wline_q <= wline_d;
-      wgray_q <= wline_d ^ (wline_d >> 1);
+      wline_q  <= wline_d;
+      wgray_q  <= wline_d ^ (wline_d >> 1);
+      cvalid_q <= cvalid_d;
     end
   end
 

@@ -59,24 +59,30 @@ class Bench:
         await FallingEdge(d.clk_i)
         d.rst_i.value = 0
 
+    async def offer(self, ident: int, data: int):
+        """Hold one slot on the port until the array takes it (ready in the same clock);
+        returns at the falling edge after the clock that took it."""
+        d = self.dut
+        d.instr_valid_i.value = 1
+        d.ident_i.value = ident
+        d.data_i.value = data
+        while True:
+            await ReadOnly()
+            taken = int(d.instr_ready_o.value)
+            await FallingEdge(d.clk_i)
+            if taken:
+                break
+        d.instr_valid_i.value = 0
+
     async def play(self, slots):
-        """Offer each slot until the array takes it (ready in the same clock)."""
+        """Offer each slot until the array takes it, with random idle clocks between."""
         d = self.dut
         for ident, data in slots:
             await FallingEdge(d.clk_i)
             while self.idle and self.rng.random() < self.idle:
                 d.instr_valid_i.value = 0
                 await FallingEdge(d.clk_i)
-            d.instr_valid_i.value = 1
-            d.ident_i.value = ident
-            d.data_i.value = data
-            while True:
-                await ReadOnly()
-                taken = int(d.instr_ready_o.value)
-                await FallingEdge(d.clk_i)
-                if taken:
-                    break
-            d.instr_valid_i.value = 0
+            await self.offer(ident, data)
 
     async def play_paced(self, slots, rate: int, htotal: int):
         """The display's bus: slot k of a line of `htotal` slots (Nops pad each line) is
@@ -101,16 +107,7 @@ class Bench:
                 backlog = max(backlog, (self.cycle - base) // rate - k)
                 if ident == isa.REFRESH:
                     due_refresh.append(base + k * rate)
-                d.instr_valid_i.value = 1
-                d.ident_i.value = ident
-                d.data_i.value = data
-                while True:
-                    await ReadOnly()
-                    taken = int(d.instr_ready_o.value)
-                    await FallingEdge(d.clk_i)
-                    if taken:
-                        break
-                d.instr_valid_i.value = 0
+                await self.offer(ident, data)
                 k += 1
         return due_refresh, backlog
 
