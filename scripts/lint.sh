@@ -39,7 +39,8 @@ done
 python3 rtl/varray/gen_vpe.py build/varray/de_vpe.sv >/dev/null
 lint_top de_varray $pkg build/varray/de_vpe.sv rtl/varray/de_varray.sv
 lint_top de_span_array $pkg rtl/varray/de_span_array.sv
-lint_top de_span_video $pkg rtl/varray/de_span_array.sv rtl/varray/de_afifo.sv rtl/varray/de_span_video.sv
+lint_top de_span_video $pkg rtl/varray/de_span_array.sv rtl/varray/de_afifo.sv rtl/varray/de_skid.sv \
+  rtl/varray/de_span_video.sv
 if ! verible-verilog-lint $(find rtl -name '*.sv' | sort); then fail=1; fi
 [[ $fail -eq 0 ]] && echo "lint: clean ($(find rtl -name '*.sv' | wc -l) files)"
 exit $fail

@@ -29,7 +29,8 @@ module de_afifo #(
     return b ^ (b >> 1);
   endfunction
 
-  logic [W-1:0] mem [1 << AW];
+  // Asynchronous read: distributed RAM (a block RAM would need a read register).
+  (* ram_style = "distributed" *) logic [W-1:0] mem [1 << AW];
   logic [AW:0] wgray_q, rgray_q;            // each side's pointer, Gray-coded
 
   // ---- write domain ----

@@ -59,10 +59,11 @@ module de_span_video
   logic rst_c1_q, rst_c2_q;                  // rst_i synchronised to the core clock
   logic              fvalid, fready, cready;
   logic [IdW+DataW-1:0] fword;
-  // The FIFO's output (a read of its distributed RAM) is registered before the array:
-  // otherwise that read runs straight into the array's front-end decode.
-  logic              cvalid_d, cvalid_q;
-  logic [IdW+DataW-1:0] cword_d, cword_q;
+  // A two-entry skid buffer between the FIFO and the array: the FIFO's read (distributed
+  // RAM) ends in a register, and the FIFO's read enable depends on the buffer's count
+  // only, not on the array's ready (its front-end decode).
+  logic              cvalid;
+  logic [IdW+DataW-1:0] cword;
 
   de_afifo #(.W(IdW + DataW), .AW(FifoAw)) u_fifo (
     .wclk_i  (clk_i),
@@ -76,15 +77,16 @@ module de_span_video
     .rready_i(fready),
     .rdata_o (fword)
   );
-  assign fready = !cvalid_q || cready;
-  always_comb begin
-    cvalid_d = cvalid_q;
-    cword_d  = cword_q;
-    if (fready) begin
-      cvalid_d = fvalid;
-      cword_d  = fword;
-    end
-  end
+  de_skid #(.W(IdW + DataW)) u_skid (
+    .clk_i  (clk_core_i),
+    .rst_i  (rst_c2_q),
+    .valid_i(fvalid),
+    .ready_o(fready),
+    .data_i (fword),
+    .valid_o(cvalid),
+    .ready_i(cready),
+    .data_o (cword)
+  );
   assign ovf_d = ovf_q || fifo_full;
 
   // ==== core clock: the array and the line buffer writes ==================================
@@ -96,10 +98,10 @@ module de_span_video
   de_span_array #(.NumCols(NumCols), .MaxSlots(MaxSlots), .CarryBug(CarryBug)) u_span (
     .clk_i        (clk_core_i),
     .rst_i        (rst_c2_q),
-    .instr_valid_i(cvalid_q),
+    .instr_valid_i(cvalid),
     .instr_ready_o(cready),
-    .ident_i      (cword_q[IdW+DataW-1 -: IdW]),
-    .data_i       (cword_q[DataW-1:0]),
+    .ident_i      (cword[IdW+DataW-1 -: IdW]),
+    .data_i       (cword[DataW-1:0]),
     .pixel_valid_o(cpix_valid),
     .pixel_o      (cpix),
     .pixel_col_o  (cpix_col),
@@ -121,15 +123,12 @@ module de_span_video
   always_ff @(posedge clk_core_i) begin
     rst_c1_q <= rst_i;
     rst_c2_q <= rst_c1_q;
-    cword_q  <= cword_d;
     if (rst_c2_q) begin
-      wline_q  <= '0;
-      wgray_q  <= '0;
-      cvalid_q <= 1'b0;
+      wline_q <= '0;
+      wgray_q <= '0;
     end else begin
-      wline_q  <= wline_d;
-      wgray_q  <= wline_d ^ (wline_d >> 1);
-      cvalid_q <= cvalid_d;
+      wline_q <= wline_d;
+      wgray_q <= wline_d ^ (wline_d >> 1);
     end
   end
 

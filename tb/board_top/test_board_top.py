@@ -525,6 +525,7 @@ def board_sources():
         "ctrl/display_controller.sv", "board/de_uart_rx.sv", "board/de_uart_tx.sv",
         "board/de_loader.sv", "board/de_fs_player.sv", "board/de_tmds_enc.sv",
         "board/de_board_core.sv", "varray/de_span_array.sv", "varray/de_afifo.sv",
+        "varray/de_skid.sv",
         "varray/de_span_video.sv")]
 
 

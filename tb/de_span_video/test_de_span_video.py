@@ -121,6 +121,7 @@ def test_de_span_video(chips, lat, bug):
             RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
             RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv",
             RTL / "varray" / "de_span_array.sv", RTL / "varray" / "de_afifo.sv",
+            RTL / "varray" / "de_skid.sv",
             RTL / "varray" / "de_span_video.sv", here / "tb_de_span_video.sv"]
     build_and_test(here, "tb_de_span_video", srcs, "test_de_span_video",
                    parameters={"NumChips": chips, "Latency": lat, "CarryBug": bug},

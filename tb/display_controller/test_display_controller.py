@@ -555,6 +555,7 @@ def test_display_controller(name):
             RTL / "ctrl" / "de_access_ctrl.sv", RTL / "ctrl" / "de_load_monitor.sv",
             RTL / "ctrl" / "de_display_core.sv", RTL / "ctrl" / "display_controller.sv",
             RTL / "varray" / "de_span_array.sv", RTL / "varray" / "de_afifo.sv",
+            RTL / "varray" / "de_skid.sv",
             RTL / "varray" / "de_span_video.sv"]
     build_and_test(HERE, "display_controller", srcs, "test_display_controller",
                    parameters=RUNS[name],
