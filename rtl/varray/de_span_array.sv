@@ -160,9 +160,11 @@ module de_span_array
   logic [PW-1:0] wr_ptr, iss_ptr;
   assign wr_ptr  = wr_cnt_q[PW-1:0];
   assign iss_ptr = iss_cnt_q[PW-1:0];
-  logic room;
   // Entry wr_ptr is free while fewer than NPass passes are committed and not retired.
-  assign room = (PW + 1)'(wr_cnt_q - ret_cnt_q) < (PW + 1)'(NPass);
+  // Registered, and counted as if the previous clock had committed a pass (one entry
+  // is given up): the ready decision then needs no subtraction after the slot's decode.
+  logic room_d, room_q;
+  assign room_d = (PW + 1)'(wr_cnt_q - ret_cnt_d) < (PW + 1)'(NPass - 1);
 
   // The open group.
   logic        open_d, open_q, per_d, per_q, accm_d, accm_q;
@@ -171,18 +173,19 @@ module de_span_array
   logic [PixW-1:0] i12_d, i12_q;
   logic [3:0]  nslot_d, nslot_q;
 
-  logic is_dat, closer, full, pend, commit, take, slot_we, ref_we;
+  logic is_dat, closer, full_d, full_q, pend_d, pend_q, commit, take, slot_we, ref_we;
   hdr_t hdr_w;
   assign is_dat = !id.addr && !id.refresh && (id.data || id.acc);
   assign closer = !is_dat;
-  assign full   = (nslot_q == 4'(K));
+  // Registered from the next state: the ready decision reads them straight from flops.
+  assign full_d = (nslot_d == 4'(K));
   // The group holds something to do: slots, or an Eval0 / Dis of its own.
-  assign pend   = open_q && ((nslot_q != '0) || (eff_q != EffNone));
+  assign pend_d = open_d && ((nslot_d != '0) || (eff_d != EffNone));
   // A slot that ends the group (or overflows it) waits one clock while the group is
   // written: one table write per clock, in stream order.
-  assign commit = instr_valid_i && pend && (closer || full) && room;
-  assign take   = instr_valid_i && !(pend && (closer || full)) &&
-                  (room || !(id.refresh || (is_dat && open_q)));
+  assign commit = instr_valid_i && pend_q && (closer || full_q) && room_q;
+  assign take   = instr_valid_i && !(pend_q && (closer || full_q)) &&
+                  (room_q || !(id.refresh || (is_dat && open_q)));
   assign slot_we = take && is_dat && open_q;
   assign ref_we  = take && id.refresh;
 
@@ -566,6 +569,9 @@ module de_span_array
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
       open_q    <= 1'b0;
+      room_q    <= 1'b1;
+      full_q    <= 1'b0;
+      pend_q    <= 1'b0;
       per_q     <= 1'b0;
       eff_q     <= EffNone;
       x_q       <= '0;
@@ -601,6 +607,9 @@ module de_span_array
       end
     end else begin
       open_q    <= open_d;
+      room_q    <= room_d;
+      full_q    <= full_d;
+      pend_q    <= pend_d;
       per_q     <= per_d;
       eff_q     <= eff_d;
       x_q       <= x_d;
