@@ -1,7 +1,7 @@
 // Difference Engine: the span-serial virtual array (docs/fpga.md, "Span-serial array").
 //
 // The same architectural state as NumCols x-processors (A-D, protect, dis and lock flags
-// per column; docs/isa.md section 6), kept in one block RAM, and the same pixels for the
+// per column; docs/isa.md section 6), kept in block RAM, and the same pixels for the
 // same 48-bit instruction stream, but the work is done only where a command acts. The
 // plain array passes every slot through every PE (NumCols operations per slot); here a
 // command visits only the columns of its span, one column per clock.
@@ -10,13 +10,16 @@
 //               (they act exactly on the address slot's span, isa.md section 5), writes
 //               it into a 16-entry pass table; a group of more than MaxSlots slots is
 //               split into passes of MaxSlots (each slot is its own chain, so a split
-//               is exact). Refresh is a pass over every column.
+//               is exact).
 //   issue       walks a pass's columns (range: X..X+dX-1, periodic: X, X+dX, ...,
 //               clipped at NumCols), one token per clock, reading the column's state.
-//   stage 0     Eval0 / Dis of the address slot, Refresh (pixel out, state cleared).
+//   stage 0     Eval0 / Dis of the address slot (after the RAM read and its register).
 //   stage 1..K  slot j-1 of the pass: forward differencing with the value carried from
 //               the previous column of the same pass (cv_q), or ACC (D += A).
-//   write back  the column's state, K+2 clocks after it was read.
+//   write back  the column's state, K+3 clocks after it was read.
+//   Refresh     one token: the engine moves to the other of two state banks; once the
+//               token reaches write back, the old bank is drained (D[35:24] out, one
+//               column per clock, column cleared) while the next line runs.
 //
 // A token is not issued while its column is in flight (read, not yet written back), so
 // passes over overlapping spans see each other's results in stream order.
@@ -25,8 +28,8 @@
 // pixels per Refresh, in column order, with their column). Acc_mode is global state:
 // every column sees Acc_mode and Refresh slots in the same order relative to every other
 // command, so one register captured per pass is the per-column flag of the plain array.
-// Reset: rst_i for one clock; the state RAM is then cleared column by column (NumCols
-// clocks, busy_o high) before the first pass is issued.
+// Reset: rst_i for one clock; bank 0 is then cleared through the pipeline and bank 1 by
+// the drain (NumCols clocks, busy_o high) before the first pass is issued.
 module de_span_array
   import de_pkg::*;
 #(
