@@ -47,6 +47,70 @@ module de_chip
   // Keep the chip a module of its own in Verilator's C++: the 72 instances then share one
   // class instead of flattening 648 PEs into one 90 MB root (build time 11 -> 2 min for 72 chips on 2 cores).
   /* verilator no_inline_module */
+
+  // The chip is its core (PEs, bypass, chains: no register between its bus input and
+  // output) followed by the boundary registers. The split lets the fast simulation
+  // (sim/fast, docs/simulation.md) cut the array at the registers and compile one chip
+  // once; the logic is the same either way.
+  logic [IdW-1:0]   core_id;
+  logic [DataW-1:0] core_data;
+  logic             core_pixv, core_coll;
+  logic [PixW-1:0]  core_pix;
+
+  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .FaultMask(FaultMask)) u_core (
+    .clk_i, .rst_i, .id_i, .data_i, .pix_valid_i, .pix_i,
+    .id_o       (core_id),
+    .data_o     (core_data),
+    .pix_valid_o(core_pixv),
+    .pix_o      (core_pix),
+    .coll_o     (core_coll),
+    .cfg_mode_i, .cfg_bit_i, .cfg_bit_o,
+    .obs_load_i, .obs_shift_i, .obs_bit_i, .obs_bit_o,
+    .bypass_o
+  );
+
+  de_chip_bound u_bound (
+    .clk_i, .rst_i,
+    .id_i       (core_id),
+    .data_i     (core_data),
+    .pix_valid_i(core_pixv),
+    .pix_i      (core_pix),
+    .coll_i     (core_coll),
+    .id_o, .data_o, .pix_valid_o, .pix_o,
+    .coll_o     (collision_o)
+  );
+endmodule
+
+// The chip without its boundary registers: bus and pixel chain from input to output
+// pass through bypass muxes and OR gates only (the PEs' own outputs are registered).
+/* verilator lint_off DECLFILENAME */
+module de_chip_core
+  import de_pkg::*;
+#(
+  parameter int unsigned NumPe     = 9,
+  parameter int unsigned CarryBug  = 0,
+  parameter logic [31:0] FaultMask = '0
+) (
+  input  logic             clk_i,
+  input  logic             rst_i,
+  input  logic [IdW-1:0]   id_i,
+  input  logic [DataW-1:0] data_i,
+  output logic [IdW-1:0]   id_o,         // combinational: the last PE's bus (or bypass)
+  output logic [DataW-1:0] data_o,
+  input  logic             pix_valid_i,
+  input  logic [PixW-1:0]  pix_i,
+  output logic             pix_valid_o,  // combinational: pix_i OR the PEs' pixels
+  output logic [PixW-1:0]  pix_o,
+  output logic             coll_o,       // combinational: two pixels met in this chip
+  input  logic             cfg_mode_i,
+  input  logic             cfg_bit_i,
+  output logic             cfg_bit_o,
+  input  logic             obs_load_i,
+  input  logic             obs_shift_i,
+  input  logic             obs_bit_i,
+  output logic             obs_bit_o,
+  output logic [NumPe-1:0] bypass_o
+);
   // Observation word per PE: {pA,pB,pC,dis,lock,acc_mode,act,id1} and the 12 control
   // pipeline bits {xz1 .. accc3}; positions follow dbg_o (structural.DBG_FIELDS).
   localparam int unsigned ObsW     = 31;
@@ -123,7 +187,43 @@ module de_chip
   end
   assign obs_bit_o = obs_q[0];
 
-  // Boundary registers.
+  // Configuration and observation registers.
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      byp_q <= '0;
+      obs_q <= '0;
+    end else begin
+      byp_q <= byp_d;
+      obs_q <= obs_d;
+    end
+  end
+
+  assign id_o        = bus_id[NumPe];
+  assign data_o      = bus_data[NumPe];
+  assign pix_valid_o = pixv_or[NumPe];
+  assign pix_o       = pix_or[NumPe];
+  assign coll_o      = |coll;
+
+endmodule
+
+// A chip's boundary registers: they keep the combinational depth independent of the chip
+// count and give both buses exactly one register per chip (docs/array.md).
+module de_chip_bound
+  import de_pkg::*;
+(
+  input  logic             clk_i,
+  input  logic             rst_i,
+  input  logic [IdW-1:0]   id_i,
+  input  logic [DataW-1:0] data_i,
+  input  logic             pix_valid_i,
+  input  logic [PixW-1:0]  pix_i,
+  input  logic             coll_i,
+  output logic [IdW-1:0]   id_o,
+  output logic [DataW-1:0] data_o,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
+  output logic             coll_o
+);
   logic [IdW-1:0]   id_q;
   logic [DataW-1:0] data_q;
   logic             pixv_q;
@@ -132,21 +232,17 @@ module de_chip
 
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
-      byp_q  <= '0;
-      obs_q  <= '0;
       id_q   <= '0;
       data_q <= '0;
       pixv_q <= 1'b0;
       pix_q  <= '0;
       coll_q <= 1'b0;
     end else begin
-      byp_q  <= byp_d;
-      obs_q  <= obs_d;
-      id_q   <= bus_id[NumPe];
-      data_q <= bus_data[NumPe];
-      pixv_q <= pixv_or[NumPe];
-      pix_q  <= pix_or[NumPe];
-      coll_q <= |coll;
+      id_q   <= id_i;
+      data_q <= data_i;
+      pixv_q <= pix_valid_i;
+      pix_q  <= pix_i;
+      coll_q <= coll_i;
     end
   end
 
@@ -154,6 +250,5 @@ module de_chip
   assign data_o      = data_q;
   assign pix_valid_o = pixv_q;
   assign pix_o       = pix_q;
-  assign collision_o = coll_q;
-
+  assign coll_o      = coll_q;
 endmodule

@@ -1,0 +1,78 @@
+// Fast simulation (docs/simulation.md, "The fast array"): a de_array with the same
+// parameters and ports as rtl/array/de_array.sv whose chips run in the composed C++ model
+// of sim/fast/de_fast.cpp (one compiled chip model called once per chip). Every output
+// of de_array is a register, so this shell calls the model once per rising edge with the
+// inputs of the ending cycle and registers what it returns: cycle for cycle the same
+// ports. Built instead of rtl/array/de_array.sv by the fast harness builds only
+// (sim/Makefile, sim/dc/Makefile with FAST=1); sim/fast/equiv.cpp checks the two against
+// each other every cycle.
+/* verilator lint_off DECLFILENAME */
+module de_array
+  import de_pkg::*;
+#(
+  parameter int unsigned NumChips  = 72,
+  parameter int unsigned CarryBug  = 0,
+  parameter int unsigned NumPe     = 9,
+  parameter logic [1023:0] FaultMask = '0
+) (
+  input  logic             clk_i,
+  input  logic             rst_i,
+  input  logic [IdW-1:0]   ident_i,
+  input  logic [DataW-1:0] data_i,
+  output logic [IdW-1:0]   ident_o,
+  output logic [DataW-1:0] data_o,
+  output logic             pixel_valid_o,
+  output logic [PixW-1:0]  pixel_o,
+  output logic [15:0]      n_pe_o,
+  output logic             pix_collision_o,
+  input  logic             cfg_mode_i,
+  input  logic             cfg_bit_i,
+  output logic             cfg_bit_o,
+  input  logic             obs_load_i,
+  input  logic             obs_shift_i,
+  output logic             obs_bit_o
+);
+  import "DPI-C" function chandle de_fast_new(input int num_chips, input int num_pe,
+                                              input int carry_bug, input string scope);
+  import "DPI-C" function void de_fast_step(
+    input chandle h, input bit rst, input int ident, input longint data,
+    input bit cfg_mode, input bit cfg_bit, input bit obs_load, input bit obs_shift,
+    output int ident_o, output longint data_o, output bit pixv_o, output int pix_o,
+    output bit coll_o, output bit cfg_bit_o, output bit obs_bit_o);
+
+  if (FaultMask != '0) begin : g_bad_fault_mask
+    $fatal(1, "de_array (sim/fast): FaultMask is a test of the flat RTL only");
+  end
+
+  chandle h;
+  initial h = de_fast_new(NumChips, NumPe, CarryBug, $sformatf("%m"));
+
+  int          s_id, s_pix;
+  longint      s_data;
+  bit          s_pixv, s_coll, s_cfg, s_obs;
+  logic [IdW-1:0]   id_q;
+  logic [DataW-1:0] data_q;
+  logic             pixv_q, coll_q, cfg_q, obs_q;
+  logic [PixW-1:0]  pix_q;
+
+  always @(posedge clk_i) begin
+    de_fast_step(h, rst_i, 32'(ident_i), 64'(data_i), cfg_mode_i, cfg_bit_i, obs_load_i,
+                 obs_shift_i, s_id, s_data, s_pixv, s_pix, s_coll, s_cfg, s_obs);
+    id_q   <= IdW'(s_id);
+    data_q <= DataW'(s_data);
+    pixv_q <= s_pixv;
+    pix_q  <= PixW'(s_pix);
+    coll_q <= s_coll;
+    cfg_q  <= s_cfg;
+    obs_q  <= s_obs;
+  end
+
+  assign ident_o         = id_q;
+  assign data_o          = data_q;
+  assign pixel_valid_o   = pixv_q;
+  assign pixel_o         = pix_q;
+  assign n_pe_o          = 16'(NumChips * NumPe);
+  assign pix_collision_o = coll_q;
+  assign cfg_bit_o       = cfg_q;
+  assign obs_bit_o       = obs_q;
+endmodule

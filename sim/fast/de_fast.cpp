@@ -1,0 +1,184 @@
+// Fast simulation of de_array: the composed model (de_fast.h) and the DPI functions the
+// shell sim/fast/de_array_dpi.sv calls. docs/simulation.md explains the cut and why.
+#include "de_fast.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "Vde_fast_head.h"
+#include "Vde_fast_tail.h"
+#include "Vde_fast_unit.h"
+#include "svdpi.h"
+#include "verilated.h"
+
+#ifndef DE_FAST_NUM_PE
+#error "DE_FAST_NUM_PE must name the NumPe the pieces were Verilated with"
+#endif
+#ifndef DE_FAST_CARRY_BUG
+#error "DE_FAST_CARRY_BUG must name the CarryBug the pieces were Verilated with"
+#endif
+
+namespace de_fast {
+
+int Array::compiled_num_pe() { return DE_FAST_NUM_PE; }
+int Array::compiled_carry_bug() { return DE_FAST_CARRY_BUG; }
+
+Array::Array(int num_chips, int num_pe, int carry_bug) : num_chips_(num_chips) {
+  if (num_chips < 1) throw std::runtime_error("de_fast: NumChips must be at least 1");
+  if (num_pe != DE_FAST_NUM_PE || carry_bug != DE_FAST_CARRY_BUG)
+    throw std::runtime_error("de_fast: the chip model was built with NumPe=" +
+                             std::to_string(DE_FAST_NUM_PE) + " CarryBug=" +
+                             std::to_string(DE_FAST_CARRY_BUG) + ", the design asks for NumPe=" +
+                             std::to_string(num_pe) + " CarryBug=" + std::to_string(carry_bug));
+  ctx_ = std::make_unique<VerilatedContext>();
+  head_ = std::make_unique<Vde_fast_head>(ctx_.get(), "head");
+  units_.reserve(static_cast<size_t>(num_chips - 1));
+  for (int c = 1; c < num_chips; ++c)
+    units_.emplace_back(new Vde_fast_unit(ctx_.get(), ("chip" + std::to_string(c)).c_str()));
+  tail_ = std::make_unique<Vde_fast_tail>(ctx_.get(), "tail");
+  head_->clk_i = 0;
+  head_->eval();
+  for (auto& u : units_) {
+    u->clk_i = 0;
+    u->eval();
+  }
+  tail_->clk_i = 0;
+  tail_->eval();
+}
+
+Array::~Array() {
+  head_->final();
+  for (auto& u : units_) u->final();
+  tail_->final();
+}
+
+namespace {
+// A rising edge, then the clock low again (ready for the next edge). Between the two
+// evaluations nothing changes: the second one only re-arms the edge detector.
+template <class M>
+inline void edge(M& m) {
+  m.clk_i = 1;
+  m.eval_step();
+  m.clk_i = 0;
+  m.eval_step();
+}
+}  // namespace
+
+Out Array::step(const In& in) {
+  // 1. The head's core is combinational from ident_i/data_i: settle it for this cycle.
+  Vde_fast_head& h = *head_;
+  h.rst_i = in.rst;
+  h.ident_i = in.ident;
+  h.data_i = in.data;
+  h.cfg_mode_i = in.cfg_mode;
+  h.cfg_bit_i = in.cfg_bit;
+  h.obs_load_i = in.obs_load;
+  h.obs_shift_i = in.obs_shift;
+  h.eval_step();
+
+  // 2. Tail first, then the units from the last to the first: each piece reads its
+  //    upstream neighbour before that neighbour's edge.
+  Vde_fast_tail& t = *tail_;
+  bool coll_others = false;
+  for (auto& u : units_) coll_others |= u->prev_coll_o;
+  t.rst_i = in.rst;
+  t.coll_others_i = coll_others;
+  if (units_.empty()) {
+    t.id_i = h.id_o;
+    t.data_i = h.data_o;
+    t.pix_valid_i = h.pix_valid_o;
+    t.pix_i = h.pix_o;
+    t.coll_i = h.coll_o;
+  } else {
+    Vde_fast_unit& l = *units_.back();
+    t.id_i = l.id_o;
+    t.data_i = l.data_o;
+    t.pix_valid_i = l.pix_valid_o;
+    t.pix_i = l.pix_o;
+    t.coll_i = l.coll_o;
+  }
+  edge(t);
+
+  for (size_t k = units_.size(); k-- > 0;) {
+    Vde_fast_unit& u = *units_[k];
+    u.rst_i = in.rst;
+    u.cfg_mode_i = in.cfg_mode;
+    u.obs_load_i = in.obs_load;
+    u.obs_shift_i = in.obs_shift;
+    if (k == 0) {
+      u.id_i = h.id_o;
+      u.data_i = h.data_o;
+      u.pix_valid_i = h.pix_valid_o;
+      u.pix_i = h.pix_o;
+      u.coll_i = h.coll_o;
+      u.cfg_bit_i = h.cfg_bit_o;
+      u.obs_bit_i = h.obs_bit_o;
+    } else {
+      const Vde_fast_unit& p = *units_[k - 1];
+      u.id_i = p.id_o;
+      u.data_i = p.data_o;
+      u.pix_valid_i = p.pix_valid_o;
+      u.pix_i = p.pix_o;
+      u.coll_i = p.coll_o;
+      u.cfg_bit_i = p.cfg_bit_o;
+      u.obs_bit_i = p.obs_bit_o;
+    }
+    edge(u);
+  }
+
+  // 3. The head last.
+  h.clk_i = 1;
+  h.eval_step();
+  h.clk_i = 0;
+
+  Out o;
+  o.ident = t.ident_o;
+  o.data = t.data_o;
+  o.pixel_valid = t.pixel_valid_o;
+  o.pixel = t.pixel_o;
+  o.collision = t.pix_collision_o;
+  if (units_.empty()) {
+    o.cfg_bit = h.cfg_bit_o;
+    o.obs_bit = h.obs_bit_o;
+  } else {
+    o.cfg_bit = units_.back()->cfg_bit_o;
+    o.obs_bit = units_.back()->obs_bit_o;
+  }
+  return o;
+}
+
+}  // namespace de_fast
+
+// ---- DPI: the shell sim/fast/de_array_dpi.sv -----------------------------------------
+extern "C" void* de_fast_new(int num_chips, int num_pe, int carry_bug, const char* scope) {
+  try {
+    return new de_fast::Array(num_chips, num_pe, carry_bug);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", scope, e.what());
+    std::exit(2);
+  }
+}
+
+extern "C" void de_fast_step(void* hp, svBit rst, int ident, long long data, svBit cfg_mode,
+                             svBit cfg_bit, svBit obs_load, svBit obs_shift, int* ident_o,
+                             long long* data_o, svBit* pixv_o, int* pix_o, svBit* coll_o,
+                             svBit* cfg_bit_o, svBit* obs_bit_o) {
+  auto* a = static_cast<de_fast::Array*>(hp);
+  de_fast::In in;
+  in.rst = rst;
+  in.ident = static_cast<uint16_t>(ident);
+  in.data = static_cast<uint64_t>(data);
+  in.cfg_mode = cfg_mode;
+  in.cfg_bit = cfg_bit;
+  in.obs_load = obs_load;
+  in.obs_shift = obs_shift;
+  const de_fast::Out o = a->step(in);
+  *ident_o = o.ident;
+  *data_o = static_cast<long long>(o.data);
+  *pixv_o = o.pixel_valid;
+  *pix_o = o.pixel;
+  *coll_o = o.collision;
+  *cfg_bit_o = o.cfg_bit;
+  *obs_bit_o = o.obs_bit;
+}

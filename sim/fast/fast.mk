@@ -1,0 +1,20 @@
+# Included by sim/Makefile and sim/dc/Makefile: what a build needs to use the fast array
+# (docs/simulation.md, "The fast array") in place of rtl/array/de_array.sv.
+#   $(FAST_SHELL)  the de_array shell to Verilate instead of rtl/array/de_array.sv
+#   $(FAST_CPP)    the composed model and its DPI functions
+#   $(FAST_LIBS)   the three Verilated pieces (built by the fast-pieces target)
+#   $(FAST_VFLAGS) include paths and the compiled NumPe/CarryBug for $(FAST_CPP)
+# The pieces depend only on the chip RTL and CARRY_BUG, so every array size and the
+# display controller share one set (sim/build/fast_b<CARRY_BUG>).
+FAST_DIR := $(ROOT)/sim/build/fast_b$(CARRY_BUG)
+FAST_SHELL := $(ROOT)/sim/fast/de_array_dpi.sv
+FAST_CPP := $(ROOT)/sim/fast/de_fast.cpp
+FAST_LIBS := $(foreach p,head unit tail,$(FAST_DIR)/$(p)/Vde_fast_$(p)__ALL.a)
+FAST_VFLAGS := -CFLAGS "-I$(FAST_DIR)/head -I$(FAST_DIR)/unit -I$(FAST_DIR)/tail \
+  -I$(ROOT)/sim/fast -DDE_FAST_NUM_PE=9 -DDE_FAST_CARRY_BUG=$(CARRY_BUG)"
+
+# Always asks the pieces' own make (cheap when they are up to date), under a lock.
+fast-pieces:
+	@mkdir -p $(ROOT)/sim/build
+	@flock $(FAST_DIR).lock $(MAKE) -s -j 3 -f $(ROOT)/sim/fast/pieces.mk \
+	  FASTDIR=$(FAST_DIR) CARRY_BUG=$(CARRY_BUG)
