@@ -6,13 +6,14 @@ SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST)))/../..)
 CARRY_BUG ?= 0
 NUM_PE := 9
+FAST_CFLAGS ?= -O2
 FASTDIR ?= $(ROOT)/sim/build/fast_b$(CARRY_BUG)
 RTL := $(addprefix $(ROOT)/rtl/,xproc/de_pkg.sv xproc/de_pe.sv proto/de_skew.sv \
        proto/de_deskew.sv array/de_chip.sv)
 CCACHE := $(shell command -v ccache 2>/dev/null)
 MAKE_FLAGS := -MAKEFLAGS CFG_CXXFLAGS_PCH_I=-include $(if $(CCACHE),-MAKEFLAGS OBJCACHE=$(CCACHE),)
 VFLAGS := --cc --build -O3 --x-assign fast --x-initial fast --noassert -Wno-fatal -Wno-lint \
-  -Wno-style -CFLAGS -O2 $(MAKE_FLAGS)
+  -Wno-style -CFLAGS "$(FAST_CFLAGS)" $(MAKE_FLAGS)
 PARAMS_head := -GNumPe=$(NUM_PE) -GCarryBug=$(CARRY_BUG)
 PARAMS_unit := -GNumPe=$(NUM_PE) -GCarryBug=$(CARRY_BUG)
 PARAMS_tail :=

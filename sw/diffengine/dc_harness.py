@@ -36,16 +36,19 @@ class Config:
     carry_bug: bool = False
     threads: int = 1
     test: tuple[int, ...] = DEFAULT_TEST
+    # True: Verilate rtl/array/de_array.sv whole; False: the fast array (sim/fast).
+    flat: bool = False
 
     def make_vars(self) -> list[str]:
         return [f"CHIPS={self.chips}", f"NUMBUF={self.num_buf}", f"BUFDEPTH={self.buf_depth}",
                 f"CARRY_BUG={int(self.carry_bug)}", f"THREADS={self.threads}",
-                "TEST=" + " ".join(str(t) for t in self.test)]
+                "TEST=" + " ".join(str(t) for t in self.test), f"FLAT={int(self.flat)}"]
 
     @property
     def tag(self) -> str:
         return (f"dc_c{self.chips}_n{self.num_buf}_d{self.buf_depth}_b{int(self.carry_bug)}"
-                f"_t{self.threads}_m" + "-".join(str(t) for t in self.test))
+                f"_t{self.threads}_m" + "-".join(str(t) for t in self.test)
+                + ("_flat" if self.flat else ""))
 
     def size(self, mode: int) -> tuple[int, int]:
         """(width, height) of the frame in `mode`."""
