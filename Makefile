@@ -15,7 +15,7 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: sim fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
@@ -26,6 +26,7 @@ help:
 	@echo "make demo-cmd    one command file through the golden model (DEMO_FILE=...)"
 	@echo "make test        run every test (sets itself up on first use)"
 	@echo "make sim         RTL regression vs golden model, HTML/JUnit reports (TIER=smoke|full|nightly J=2)"
+	@echo "make sim-merge   join the outputs of make sim SHARD=k/N (sim/out/shard-*) into one report"
 	@echo "make test-long   long random regressions (not part of make test)"
 	@echo "make bench       golden model speed, y-processor commands per line and host time"
 	@echo "                 (docs/performance.md)"
@@ -91,7 +92,11 @@ TIER ?= full
 J ?= 2
 sim: $(SETUP)
 	@$(MAKE) -s -C sw/hsr build/yproc
-	$(ENV) cd sw && $(PY) -m diffengine.regress --tier $(TIER) -j $(J)
+	$(ENV) cd sw && $(PY) -m diffengine.regress --tier $(TIER) -j $(J) $(if $(SHARD),--shard $(SHARD))
+
+# One report and JUnit file from the shards (SHARDS = their folders, CI: the artifacts).
+sim-merge: $(SETUP)
+	$(ENV) cd sw && $(PY) -m diffengine.regress --merge $(if $(SHARDS),$(abspath $(SHARDS)),$(ROOT)/sim/out/shard-*-of-*)
 
 # 10^7 random commands per array configuration through the RTL (hours on 2 cores).
 test-long: $(SETUP)

@@ -9,17 +9,25 @@ the carry-bug build, where they must FAIL: that proves the regression can fail, 
 report shows why it failed.
 
     python -m diffengine.regress [--tier smoke|full|nightly] [-j N] [-k TEXT] [--out DIR]
+                                 [--shard K/N]
+    python -m diffengine.regress --merge DIR... [--out DIR]
 
 Builds: one per (chip count, carry bug), made before the runs start, reused by all runs.
 Outputs in --out (default sim/out/): report.html (self-contained), junit.xml, and per case
 cases/<name>/ (stream.cmd, stream.de48, rtl.txt, and on a failure the windowed FST of the
 first bad line with its .gtkw save file). Exit status 0 when every case did what it was
 expected to do, 1 otherwise.
+
+--shard K/N runs the K-th of N shards, balanced on the durations recorded in
+sim/regress/durations.json (greedy longest first), into OUT/shard-K-of-N/; --merge joins
+the shard folders into one report.html and junit.xml, and exits 2 if a case is missing or
+ran twice (docs/regression.md, "Shards and CI matrices").
 """
 from __future__ import annotations
 
 import argparse
 import base64
+import dataclasses
 import fnmatch
 import html
 import json
@@ -536,8 +544,10 @@ def summary_table(cases: list[Case], results: dict[str, dict]) -> str:
     return "\n".join(out)
 
 
-def junit(cases: list[Case], results: dict[str, dict], tier: str, seconds: float) -> bytes:
-    suite = ET.Element("testsuite", name=f"sim-regress-{tier}", tests=str(len(cases)),
+def junit(cases: list[Case], results: dict[str, dict], tier: str, seconds: float,
+          suite_name: str | None = None) -> bytes:
+    suite = ET.Element("testsuite", name=suite_name or f"sim-regress-{tier}",
+                       tests=str(len(cases)),
                        time=f"{seconds:.3f}")
     nfail = nerr = nskip = 0
     for c in cases:
@@ -614,8 +624,25 @@ def line_svg(rtl: np.ndarray, ref: np.ndarray, y: int, x: int) -> str:
             f'<text x="2" y="{gh - 16}" font-size="10">0</text></svg>')
 
 
-def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds: float) -> str:
+def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds: float,
+                case_dirs: dict[str, Path] | None = None, out: Path | None = None,
+                note: str = "") -> str:
+    """The self-contained report. By default a case's files are linked as cases/<name>/
+    next to the report; a merged report (shards) passes `case_dirs` (name -> the case's
+    folder in its shard) and `out` (the report's folder) to link them where they are."""
     e = html.escape
+
+    def href(name: str) -> str:
+        if not case_dirs or name not in case_dirs:
+            return f"cases/{name}"
+        return Path(os.path.relpath(case_dirs[name], out or Path.cwd())).as_posix()
+
+    def shown(name: str) -> str:  # the folder as a person types it, for the gtkwave hint
+        if not case_dirs or name not in case_dirs:
+            return f"sim/out/cases/{name}"
+        d = Path(case_dirs[name]).resolve()
+        return d.relative_to(REPO).as_posix() if d.is_relative_to(REPO) else str(d)
+
     rows = []
     for c in cases:
         r = results[c.name]
@@ -634,7 +661,7 @@ def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds:
         parts = [f'<section id="{e(c.name)}"><h3>{e(c.name)} <span class="{v}">{v}</span></h3>',
                  f"<p>{e(c.source)} &middot; {c.chips} chip(s) = {c.width} columns &middot; "
                  f"{'carry-bug build, expected to fail' if c.bug else 'correct build'} &middot; "
-                 f"<a href=\"cases/{e(c.name)}/stream.cmd\">stream.cmd</a> &middot; "
+                 f"<a href=\"{e(href(c.name))}/stream.cmd\">stream.cmd</a> &middot; "
                  f"{e(r['message'])}</p>"]
         if r["reasons"]:
             parts.append("<ul>" + "".join(f"<li>{e(t)}</li>" for t in r["reasons"]) + "</ul>")
@@ -642,7 +669,7 @@ def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds:
             imgs = [_img(r["rtl"], "RTL frame", 480), _img(r["ref"], "reference", 480),
                     _img(heatmap(r["rtl"], r["ref"]), "|RTL - reference| (log)", 480)]
             parts.append('<div class="imgs">' + "".join(imgs) + "</div>")
-        if r.get("first"):
+        if r.get("first") and r["rtl"] is not None:
             y, x = r["first"]
             parts.append(f"<h4>First differing pixel: line {y}, column {x} (PE {x}, chip "
                          f"{x // PE_PER_CHIP}): RTL {int(r['rtl'][y, x])}, reference "
@@ -656,8 +683,8 @@ def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds:
                              + e(r["trace"]) + "</pre>")
             if r.get("waves"):
                 parts.append("<p>Waves of the bad line: " + ", ".join(
-                    f'<a href="cases/{e(c.name)}/{e(w)}">{e(w)}</a>' for w in r["waves"])
-                    + f" (open: <code>gtkwave sim/out/cases/{e(c.name)}/"
+                    f'<a href="{e(href(c.name))}/{e(w)}">{e(w)}</a>' for w in r["waves"])
+                    + f" (open: <code>gtkwave {e(shown(c.name))}/"
                     f"{e(r['waves'][-1])}</code>)</p>")
         if r["harness"]:
             parts.append(f"<p><small>{e(r['harness'])}</small></p>")
@@ -665,7 +692,9 @@ def html_report(cases: list[Case], results: dict[str, dict], tier: str, seconds:
     counts = summary_table(cases, results).splitlines()[-1]
     return (f"<!doctype html><html><head><meta charset=\"utf-8\"><title>sim regression: {tier}"
             f"</title><style>{_CSS}</style></head><body><h1>RTL regression, tier {tier}</h1>"
-            f"<p>{len(cases)} cases in {seconds:.1f} s: {e(counts)}. Every frame comes from "
+            f"<p>{len(cases)} cases in {seconds:.1f} s: {e(counts)}."
+            f"{' ' + e(note) if note else ''}"
+            " Every frame comes from "
             "the Verilated array (sim/harness) and is compared bit for bit with the golden "
             "model (sw/diffengine/functional.py) or a stored reference frame. "
             "XFAIL = a carry-bug build that failed, as it must.</p><table><tr><th>case</th>"
@@ -719,6 +748,318 @@ def run(cases: list[Case], out: Path, jobs: int = 2, waves: bool = True, tier: s
     return results, time.monotonic() - t0
 
 
+# ---- shards: duration-balanced, deterministic (docs/regression.md §9) --------------------
+
+# Per-case seconds recorded by earlier runs. Checked in next to the manifest (an input of
+# the scheduling, like the manifest; sim/out/ is git-ignored and wiped by make clean).
+DURATIONS = MANIFEST.parent / "durations.json"
+# The fallback estimate of a case with no recorded duration (seconds): a cost model fitted
+# to the figures of docs/regression.md §7 at 72 chips (the cube, 240 lines: 136 s; the
+# teapot channels, 480 lines: 170-280 s) and the smoke tier (1500 random commands on one
+# chip: 0.1 s); over the full tier it gives 1710 s, the measured cases added up to 1705 s.
+# The 72-chip scene times follow their line counts, not their command counts: per line the
+# cycles grow with the columns and each cycle's cost with the chips (chips^2 per line).
+LINE_COST = 1e-4     # s per line per chip^2
+CMD_COST = 1e-5      # s per command per chip
+CASE_COST = 0.05     # s per case (process, files, golden model set-up)
+SCENE_CMDS_PER_LINE = 100   # unknown before yproc runs: the teapot's ~50k / 480 lines
+RECORDING_TIERS = ("full", "nightly")   # complete runs of these tiers update DURATIONS
+
+
+def parse_shard(text: str) -> tuple[int, int]:
+    """'k/N' -> (k, N), 1 <= k <= N; ValueError with the reason otherwise."""
+    parts = str(text).strip().split("/")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        k, n = int(parts[0]), int(parts[1])
+    except ValueError:
+        raise ValueError(f"SHARD {text!r}: want k/N with whole numbers, e.g. 2/4") from None
+    if n < 1:
+        raise ValueError(f"SHARD {text!r}: N must be at least 1")
+    if not 1 <= k <= n:
+        raise ValueError(f"SHARD {text!r}: k must be in 1..{n} (shards count from 1)")
+    return k, n
+
+
+def shard_dir(out: Path, k: int, n: int) -> Path:
+    return Path(out) / f"shard-{k}-of-{n}"
+
+
+def load_durations(path: Path = DURATIONS) -> dict[str, float]:
+    """{case name: seconds} from the durations file; {} if it does not exist."""
+    path = Path(path)
+    if not path.exists():
+        return {}
+    doc = json.loads(path.read_text())
+    secs = doc.get("seconds", {}) if isinstance(doc, dict) else None
+    if not isinstance(secs, dict):
+        raise ValueError(f"{path}: want {{\"seconds\": {{case: seconds, ...}}}}")
+    return {str(k): float(v) for k, v in secs.items()}
+
+
+def case_size(case: Case) -> tuple[float, float]:
+    """(lines, commands) of a case as far as the manifest tells, without making the
+    stream: generated kinds from their parameters, files from their size, scenes from
+    their `screen W H` line."""
+    p = case.params
+    if case.kind == "random":
+        n = p.get("commands", 2000)
+        return n / (sum(p.get("per_line", (1, 40))) / 2), n
+    if case.kind == "carry":
+        return p.get("lines", 8), 6 * p.get("lines", 8)     # 2-5 spans, Refresh, Acc_mode
+    if case.kind == "chipcross":
+        return p.get("lines", 8), 13 * p.get("lines", 8)    # 12 commands + Refresh
+    if case.kind == "file":
+        try:
+            n = Path(p["path"]).stat().st_size / 16
+        except OSError:
+            n = 100
+        return max(1.0, n / 4), n
+    lines = 480
+    try:
+        for ln in Path(p["scene"]).read_text().splitlines():
+            if ln.split()[:1] == ["screen"]:
+                lines = int(ln.split()[2])
+                break
+    except (OSError, ValueError, IndexError):
+        pass
+    return lines, lines * SCENE_CMDS_PER_LINE
+
+
+def model_seconds(case: Case) -> float:
+    """The fallback cost model (LINE_COST, CMD_COST, CASE_COST)."""
+    lines, cmds = case_size(case)
+    return LINE_COST * lines * case.chips ** 2 + CMD_COST * cmds * case.chips + CASE_COST
+
+
+def estimates(cases: list[Case], durations: dict[str, float]) -> dict[str, float]:
+    """Seconds per case: the recorded duration, else model_seconds() times the median of
+    recorded / modelled seconds over the recorded cases of the selection with the same
+    kind and array size, else the same array size, else 1 (not across array sizes: a
+    1-chip case's seconds are mostly fixed costs and say little about 72 chips).
+    A pure function of its inputs."""
+    def median(v: list[float]) -> float:
+        v = sorted(v)
+        return v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2
+
+    by_kind: dict[tuple[str, int], list[float]] = {}
+    by_chips: dict[int, list[float]] = {}
+    for c in cases:
+        if c.name in durations:
+            ratio = durations[c.name] / model_seconds(c)
+            by_kind.setdefault((c.kind, c.chips), []).append(ratio)
+            by_chips.setdefault(c.chips, []).append(ratio)
+
+    def factor(c: Case) -> float:
+        if (c.kind, c.chips) in by_kind:
+            return median(by_kind[(c.kind, c.chips)])
+        return median(by_chips[c.chips]) if c.chips in by_chips else 1.0
+
+    return {c.name: durations[c.name] if c.name in durations else model_seconds(c) * factor(c)
+            for c in cases}
+
+
+def assign_shards(cases: list[Case], n: int, durations: dict[str, float]
+                  ) -> list[list[Case]]:
+    """Greedy longest-processing-time first: cases by decreasing estimate (ties by name)
+    each go to the shard with the least estimated time so far (ties: the lowest index).
+    Every case lands in exactly one shard; each shard's total stays within the longest
+    case of the ideal (total / n). Shards keep the manifest order of their cases."""
+    if n < 1:
+        raise ValueError("n must be at least 1")
+    est = estimates(cases, durations)
+    load = [0.0] * n
+    where: dict[str, int] = {}
+    for c in sorted(cases, key=lambda c: (-est[c.name], c.name)):
+        i = min(range(n), key=lambda j: (load[j], j))
+        where[c.name] = i
+        load[i] += est[c.name]
+    return [[c for c in cases if where[c.name] == i] for i in range(n)]
+
+
+def record_durations(path: Path, cases: list[Case], results: dict[str, dict],
+                     keep: set[str] | None = None) -> int:
+    """Write the measured seconds of `cases` into the durations file (other entries stay,
+    except names not in `keep`, the manifest's cases, when given). Cases that did not
+    really run (N/A, ERROR) are not recorded. Returns how many were recorded."""
+    path = Path(path)
+    old = load_durations(path) if path.exists() else {}
+    n = 0
+    for c in cases:
+        r = results[c.name]
+        if verdict(c, r) in ("N/A", "ERROR"):
+            continue
+        old[c.name] = max(0.01, round(float(r["seconds"]), 2))
+        n += 1
+    if keep is not None:
+        old = {k: v for k, v in old.items() if k in keep}
+    doc = {"about": "Seconds per case recorded by complete `make sim` runs of the full or "
+                    "nightly tier (and their `make sim-merge`); `--shard k/N` balances on "
+                    "them. docs/regression.md, section 'Shards and CI matrices'.",
+           "seconds": dict(sorted(old.items()))}
+    path.write_text(json.dumps(doc, indent=1) + "\n")
+    return n
+
+
+# ---- outputs of a run (also of a merge) -------------------------------------------------
+
+
+def write_outputs(out: Path, cases: list[Case], results: dict[str, dict], tier: str,
+                  secs: float, meta: dict, case_dirs: dict[str, Path] | None = None,
+                  suite_name: str | None = None, note: str = "") -> bool:
+    """summary.txt, junit.xml, report.html, results.json and run.json (what was run: tier,
+    shard, selection, the cases; what --merge reads back) in `out`. True if all good."""
+    out.mkdir(parents=True, exist_ok=True)
+    table = summary_table(cases, results)
+    print(table)
+    (out / "summary.txt").write_text(table + "\n")
+    (out / "junit.xml").write_bytes(junit(cases, results, tier, secs, suite_name))
+    (out / "report.html").write_text(html_report(cases, results, tier, secs, case_dirs, out,
+                                                 note))
+    (out / "results.json").write_text(json.dumps(
+        {c.name: {k: v for k, v in results[c.name].items() if k not in ("rtl", "ref")}
+         | {"verdict": verdict(c, results[c.name])} for c in cases}, indent=1, default=str))
+    ok = all(verdict(c, results[c.name]) in GOOD for c in cases)
+    (out / "run.json").write_text(json.dumps(
+        meta | {"tier": tier, "seconds": round(secs, 3), "ok": ok,
+                "cases": [dataclasses.asdict(c) for c in cases]}, indent=1, default=str))
+    return ok
+
+
+def save_frames(out: Path, cases: list[Case], results: dict[str, dict]) -> None:
+    """cases/<name>/frames.npz (RTL frame and reference): the merge's report shows them."""
+    for c in cases:
+        r = results[c.name]
+        if r.get("rtl") is not None and r.get("ref") is not None:
+            d = out / "cases" / c.name
+            d.mkdir(parents=True, exist_ok=True)
+            np.savez_compressed(d / "frames.npz", rtl=r["rtl"], ref=r["ref"])
+
+
+class MergeError(Exception):
+    """The shards do not add up to one run: a case missing, run twice, or unknown."""
+
+
+def load_run_dir(d: Path) -> tuple[dict, list[Case], dict[str, dict]]:
+    """run.json, results.json and the frames of one run (shard) folder."""
+    d = Path(d)
+    if not (d / "run.json").exists() or not (d / "results.json").exists():
+        raise MergeError(f"{d}: not a shard folder (no run.json / results.json); "
+                         "run `make sim SHARD=k/N` first, or name the folders")
+    meta = json.loads((d / "run.json").read_text())
+    stored = json.loads((d / "results.json").read_text())
+    cases = [Case(**c) for c in meta["cases"]]
+    results: dict[str, dict] = {}
+    for c in cases:
+        if c.name not in stored:
+            raise MergeError(f"{d}: case {c.name} is in run.json but not in results.json")
+        r = dict(stored[c.name])
+        r.pop("verdict", None)
+        if r.get("first") is not None:
+            r["first"] = tuple(r["first"])
+        r["rtl"] = r["ref"] = None
+        f = d / "cases" / c.name / "frames.npz"
+        if f.exists():
+            with np.load(f) as z:
+                r["rtl"], r["ref"] = z["rtl"], z["ref"]
+        results[c.name] = r
+    return meta, cases, results
+
+
+def merge_runs(dirs: list[Path]) -> tuple[dict, list[Case], dict[str, dict], dict[str, Path]]:
+    """Check that the shard folders are the N shards of one selection, with every case
+    exactly once, and join them: (meta, cases in selection order, results, case dirs)."""
+    if not dirs:
+        raise MergeError("no shard folders given")
+    runs = [(Path(d), *load_run_dir(d)) for d in dirs]
+    meta0 = runs[0][1]
+    for d, meta, _, _ in runs[1:]:
+        for key in ("tier", "selected", "pattern", "no_bug_checks"):
+            if meta.get(key) != meta0.get(key):
+                raise MergeError(f"{d} and {runs[0][0]} come from different runs ({key} "
+                                 f"differs): merge the shards of one run only")
+        if meta["shard"][1] != meta0["shard"][1]:
+            raise MergeError(f"{d} and {runs[0][0]} come from different runs (shard "
+                             f"{meta['shard'][0]}/{meta['shard'][1]} vs "
+                             f"{meta0['shard'][0]}/{meta0['shard'][1]}): merge the shards of "
+                             "one run only")
+    n = meta0["shard"][1]
+    selected = list(meta0["selected"])
+    problems = []
+    seen_k: dict[int, list[str]] = {}
+    for d, meta, _, _ in runs:
+        seen_k.setdefault(meta["shard"][0], []).append(str(d))
+    missing_k = [k for k in range(1, n + 1) if k not in seen_k]
+    where: dict[str, list[Path]] = {}
+    for d, _, cases, _ in runs:
+        for c in cases:
+            where.setdefault(c.name, []).append(d)
+    missing = [name for name in selected if name not in where]
+    if missing:
+        problems.append(f"{len(missing)} case(s) missing (in no shard): "
+                        + ", ".join(missing[:20]) + (" ..." if len(missing) > 20 else "")
+                        + (f" [shard(s) not given: {', '.join(f'{k}/{n}' for k in missing_k)}]"
+                           if missing_k else ""))
+    twice = {name: ds for name, ds in where.items() if len(ds) > 1}
+    if twice:
+        problems.append(f"{len(twice)} case(s) ran more than once: " + "; ".join(
+            f"{name} in {', '.join(map(str, ds))}" for name, ds in list(twice.items())[:20]))
+    extra = [name for name in where if name not in set(selected)]
+    if extra:
+        problems.append(f"{len(extra)} case(s) not in the run's selection: "
+                        + ", ".join(extra[:20]))
+    if problems:
+        raise MergeError("; ".join(problems))
+    cases_by: dict[str, Case] = {}
+    results: dict[str, dict] = {}
+    dirs_by: dict[str, Path] = {}
+    for d, _, cases, res in runs:
+        for c in cases:
+            cases_by[c.name], results[c.name] = c, res[c.name]
+            dirs_by[c.name] = d / "cases" / c.name
+    secs = [float(m["seconds"]) for _, m, _, _ in runs]
+    meta = {k: meta0.get(k) for k in ("manifest", "pattern", "no_bug_checks", "selected")}
+    meta |= {"shard": [1, 1], "merged_from": [str(d) for d, *_ in runs],
+             "shard_seconds": secs, "tier": meta0["tier"]}
+    return meta, [cases_by[name] for name in selected], results, dirs_by
+
+
+def _complete(meta: dict) -> bool:
+    return not meta.get("pattern") and not meta.get("no_bug_checks")
+
+
+def _record(path: Path, manifest: Path, cases, results, log=print) -> None:
+    try:
+        keep = {c.name for c in load_manifest(manifest, "nightly")}
+    except (OSError, ValueError):
+        keep = None
+    n = record_durations(path, cases, results, keep)
+    log(f"sim: recorded {n} case durations in {path}")
+
+
+def merge_main(dirs: list[Path], out: Path, durations: Path | None,
+               record: bool | None) -> int:
+    try:
+        meta, cases, results, case_dirs = merge_runs(dirs)
+    except MergeError as e:
+        print(f"sim-merge: ERROR: {e}", file=sys.stderr)
+        return 2
+    secs = max(meta["shard_seconds"], default=0.0)
+    n = len(meta["merged_from"])
+    note = (f"Merged from {n} shard(s) (longest {secs:.1f} s, together "
+            f"{sum(meta['shard_seconds']):.1f} s).")
+    ok = write_outputs(out, cases, results, meta["tier"], secs, meta, case_dirs, note=note)
+    manifest = REPO / meta.get("manifest", MANIFEST)   # repository-relative, or absolute
+    if not manifest.exists():
+        manifest = MANIFEST
+    if record or (record is None and _complete(meta) and meta["tier"] in RECORDING_TIERS):
+        _record(durations or manifest.parent / "durations.json", manifest, cases, results)
+    print(f"sim-merge: {meta['tier']} tier, {len(cases)} cases from {n} shard(s): "
+          f"{'OK' if ok else 'FAILED'}; report {out / 'report.html'}, junit {out / 'junit.xml'}")
+    return 0 if ok else 1
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m diffengine.regress",
                                  description="RTL regression: every case of the manifest "
@@ -733,32 +1074,71 @@ def main(argv=None) -> int:
     ap.add_argument("--no-bug-checks", action="store_true",
                     help="skip the expected-failure runs on the carry-bug build")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
+    ap.add_argument("--shard", metavar="K/N",
+                    help="run only the K-th of N duration-balanced shards (K = 1..N); "
+                    "outputs go to OUT/shard-K-of-N/")
+    ap.add_argument("--merge", nargs="+", type=Path, metavar="DIR",
+                    help="join the shard folders DIR... into one report in OUT (nothing "
+                    "runs); exit 2 if a case is missing or ran twice")
+    ap.add_argument("--durations", type=Path, default=None,
+                    help="recorded case durations (default: durations.json next to the "
+                    "manifest)")
+    ap.add_argument("--record-durations", action=argparse.BooleanOptionalAction,
+                    default=None, help="write the measured durations into the durations "
+                    "file (default: only for complete full/nightly runs and their merge)")
     a = ap.parse_args(argv)
+    durations = a.durations or Path(a.manifest).parent / "durations.json"
+    if a.merge:
+        return merge_main(a.merge, a.out, a.durations, a.record_durations)
+    shard = None
+    if a.shard is not None and a.shard.strip():
+        try:
+            shard = parse_shard(a.shard)
+        except ValueError as e:
+            ap.error(f"--shard: {e}")
     cases = load_manifest(a.manifest, a.tier)
     if a.pattern:
         cases = [c for c in cases if a.pattern in c.name or fnmatch.fnmatch(c.name, a.pattern)]
     if a.no_bug_checks:
         cases = [c for c in cases if not c.bug]
+    selected = [c.name for c in cases]
+    out = a.out
+    if shard:
+        k, n = shard
+        recorded = load_durations(durations)
+        cases = assign_shards(cases, n, recorded)[k - 1]
+        out = shard_dir(a.out, k, n)
+        est = estimates(cases, recorded)
+        print(f"sim: shard {k}/{n}: {len(cases)} of {len(selected)} cases, estimated "
+              f"{sum(est.values()):.1f} s ({sum(c.name in recorded for c in cases)} with a "
+              f"recorded duration, {durations.name}); outputs in {out}", flush=True)
     if a.list:
         for c in cases:
             print(f"{c.name:32s} {c.chips:3d} chips  expect {c.expect}  {c.source}")
         return 0
-    if not cases:
+    if not cases and not shard:
         print("sim: no cases selected", file=sys.stderr)
         return 1
-    results, secs = run(cases, a.out, a.jobs, not a.no_waves, a.tier,
-                        log=lambda m: print(m, flush=True))
-    table = summary_table(cases, results)
-    print(table)
-    (a.out / "summary.txt").write_text(table + "\n")
-    (a.out / "junit.xml").write_bytes(junit(cases, results, a.tier, secs))
-    (a.out / "report.html").write_text(html_report(cases, results, a.tier, secs))
-    (a.out / "results.json").write_text(json.dumps(
-        {c.name: {k: v for k, v in results[c.name].items() if k not in ("rtl", "ref")}
-         | {"verdict": verdict(c, results[c.name])} for c in cases}, indent=1, default=str))
-    ok = all(verdict(c, results[c.name]) in GOOD for c in cases)
-    print(f"sim: {a.tier} tier, {len(cases)} cases in {secs:.1f} s: "
-          f"{'OK' if ok else 'FAILED'}; report {a.out / 'report.html'}, junit {a.out / 'junit.xml'}")
+    mpath = Path(a.manifest).resolve()
+    meta = {"manifest": mpath.relative_to(REPO).as_posix() if mpath.is_relative_to(REPO)
+            else str(mpath), "pattern": a.pattern,
+            "no_bug_checks": a.no_bug_checks, "selected": selected,
+            "shard": list(shard) if shard else [1, 1]}
+    if cases:
+        results, secs = run(cases, out, a.jobs, not a.no_waves, a.tier,
+                            log=lambda m: print(m, flush=True))
+    else:   # more shards than cases: an empty shard is a success with empty reports
+        results, secs = {}, 0.0
+    save_frames(out, cases, results)
+    ok = write_outputs(out, cases, results, a.tier, secs, meta,
+                       suite_name=f"sim-regress-{a.tier}-shard-{shard[0]}-of-{shard[1]}"
+                       if shard else None)
+    if a.record_durations or (a.record_durations is None and not shard and
+                              _complete(meta) and a.tier in RECORDING_TIERS):
+        _record(durations, a.manifest, cases, results)
+    what = f"{a.tier} tier" + (f", shard {shard[0]}/{shard[1]}" if shard else "")
+    print(f"sim: {what}, {len(cases)} cases in {secs:.1f} s: "
+          f"{'OK' if ok else 'FAILED'}; report {out / 'report.html'}, junit {out / 'junit.xml'}")
     return 0 if ok else 1
 
 
