@@ -47,6 +47,7 @@ help:
 
 setup: $(SETUP)
 $(SETUP): scripts/setup.sh scripts/requirements.txt sw/pyproject.toml
+	./scripts/ensure_system.sh
 	./scripts/setup.sh
 
 # The main job (docs/pipeline.md): RTL=0 skips the Verilated controller.
@@ -55,6 +56,7 @@ CHIPS ?= 72
 THREADS ?= 1
 RTL ?= 1
 demo: $(SETUP)
+	@./scripts/ensure_system.sh
 	$(ENV) $(PY) scripts/demo.py --scene $(SCENE) --chips $(CHIPS) --threads $(THREADS) \
 	  --out $(OUT) $(if $(filter 0,$(RTL)),--no-rtl,)
 
@@ -74,9 +76,11 @@ demo-cmd: $(SETUP)
 test: test-py test-c test-rtl
 
 test-py: $(SETUP)
+	@./scripts/ensure_system.sh
 	$(ENV) cd sw && $(PY) -m pytest -q -n 2 tests
 
 test-c:
+	@./scripts/ensure_system.sh
 	$(MAKE) -C sw/hsr test
 	$(MAKE) -C sw/hsr/fuzz smoke
 
@@ -85,6 +89,7 @@ fuzz-hsr:
 	$(MAKE) -C sw/hsr/fuzz long
 
 test-rtl: $(SETUP)
+	@./scripts/ensure_system.sh
 	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 --durations=12 .; fi
 
 # The RTL regression (docs/regression.md): TIER=smoke|full|nightly, J parallel jobs.

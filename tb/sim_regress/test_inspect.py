@@ -5,10 +5,10 @@ against values computed here: the pixel (golden model), the commands acting on t
 column (stream indices), and the PE's register history (its last row against the
 functional model's final line state, every row against `diffengine trace --engine model`
 at the cycle the page names). Chromium is installed once if missing (root), like
-scripts/ensure_fst.sh does for GTKWave; without it the test fails and says why."""
+scripts/ensure_fst.sh does for GTKWave (both through scripts/ensure_system.sh);
+without it the test fails and says why."""
 from __future__ import annotations
 
-import fcntl
 import os
 import random
 import re
@@ -32,21 +32,14 @@ def ensure_chromium() -> str:
     exe = shutil.which("chromium")
     if exe:
         return exe
-    if os.geteuid() != 0:
-        pytest.fail("headless Chromium is needed for the inspector test: "
-                    "sudo apt-get install -y chromium")
-    lock = REPO / "sim" / "build" / ".chromium-install.lock"
-    lock.parent.mkdir(parents=True, exist_ok=True)
-    with open(lock, "w") as f:  # pytest-xdist workers: one apt-get at a time
-        fcntl.flock(f, fcntl.LOCK_EX)
-        if not shutil.which("chromium"):
-            print("inspect test: installing chromium (Debian package, once)", file=sys.stderr)
-            env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
-            res = subprocess.run("apt-get update -qq && apt-get install -y -qq chromium",
-                                 shell=True, capture_output=True, text=True, env=env)
-            if res.returncode:
-                pytest.fail(f"could not install chromium ({res.returncode}): "
-                            f"{res.stderr.strip()[-500:]}")
+    # scripts/ensure_system.sh: the project's one lock around apt-get (pytest-xdist workers
+    # and the other ensure scripts wait for each other); without root or sudo it says what
+    # to install and fails.
+    res = subprocess.run([str(REPO / "scripts" / "ensure_system.sh"), "chromium"],
+                         capture_output=True, text=True)
+    if res.returncode:
+        pytest.fail(f"headless Chromium is needed for the inspector test: "
+                    f"{res.stderr.strip()[-800:]}")
     exe = shutil.which("chromium")
     if not exe:
         pytest.fail("chromium installed but not on PATH")
