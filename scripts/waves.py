@@ -34,7 +34,7 @@ def pe_scope(bench: str, pe: int) -> str:
     if bench == "de_pe":
         return f"de_pe_chain.g_pe[{pe}].u_pe"
     chip, i = divmod(pe, 9)
-    return f"de_array.g_chip[{chip}].u_chip.g_pe[{i}].u_pe"
+    return f"de_array.g_chip[{chip}].u_chip.u_core.g_pe[{i}].u_pe"
 
 
 def vcd_vars(vcd: str):

@@ -273,7 +273,7 @@ bool bind(const VerilatedScope* s, const char* var, Sig& out, std::string& err) 
 }
 
 std::string pe_scope(int p) {
-  return "de_array.g_chip[" + std::to_string(p / kPePerChip) + "].u_chip.g_pe[" +
+  return "de_array.g_chip[" + std::to_string(p / kPePerChip) + "].u_chip.u_core.g_pe[" +
          std::to_string(p % kPePerChip) + "].u_pe";
 }
 
@@ -310,7 +310,7 @@ bool make_probe(int p, PeProbe& pr, std::string& err) {
     return bind(up, "id_q", pr.in_id, err) && bind(up, "out_q", pr.in_data, err);
   }
   const VerilatedScope* chip =
-      find_scope("de_array.g_chip[" + std::to_string(p / kPePerChip - 1) + "].u_chip");
+      find_scope("de_array.g_chip[" + std::to_string(p / kPePerChip - 1) + "].u_chip.u_bound");
   return bind(chip, "id_q", pr.in_id, err) && bind(chip, "data_q", pr.in_data, err);
 }
 

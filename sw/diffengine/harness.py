@@ -37,27 +37,33 @@ def default_threads(chips: int) -> int:
     return 1
 
 
-def tag(chips: int, carry_bug: bool = False, threads: int = 1, trace: bool = False) -> str:
-    return f"array_c{chips}_b{int(carry_bug)}_t{threads}_tr{int(trace)}"
+def tag(chips: int, carry_bug: bool = False, threads: int = 1, trace: bool = False,
+        flat: bool = False) -> str:
+    return (f"array_c{chips}_b{int(carry_bug)}_t{threads}_tr{int(trace)}"
+            + ("_flat" if flat and not trace else ""))
 
 
 def build(chips: int, carry_bug: bool = False, threads: int | None = None,
-          trace: bool = False) -> Path:
+          trace: bool = False, flat: bool = False) -> Path:
     """Build (or reuse) the harness for `chips` chips; returns the executable.
+
+    The default (trace=False, flat=False) is the fast array (sim/fast: the chips compiled
+    once and composed, docs/simulation.md); flat=True Verilates rtl/array/de_array.sv
+    whole, as the trace build always does.
 
     A lock file per configuration serialises concurrent callers (pytest-xdist workers
     that need the same build), so make never runs twice in one build folder."""
     import fcntl
 
     threads = default_threads(chips) if threads is None else int(threads)
-    name = tag(chips, carry_bug, threads, trace)
+    name = tag(chips, carry_bug, threads, trace, flat)
     lock_dir = REPO / "sim" / "build"
     lock_dir.mkdir(parents=True, exist_ok=True)
     with open(lock_dir / f".{name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         subprocess.run(["make", "-s", "-C", str(REPO / "sim"), "harness", f"CHIPS={chips}",
                         f"CARRY_BUG={int(carry_bug)}", f"THREADS={threads}",
-                        f"TRACE={int(trace)}"],
+                        f"TRACE={int(trace)}", f"FLAT={int(flat and not trace)}"],
                        check=True, env=dict(os.environ), stdout=subprocess.DEVNULL)
     return REPO / "sim" / "build" / name / "Vde_array"
 

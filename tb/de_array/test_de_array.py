@@ -86,7 +86,7 @@ class Array:
 
     def pe_dbg(self, q: int) -> int:
         c, i = divmod(q, NUM_PE)
-        return int(self.dut.g_chip[c].u_chip.g_pe[i].pe_dbg.value)
+        return int(self.dut.g_chip[c].u_chip.u_core.g_pe[i].pe_dbg.value)
 
     async def play(self, slots):
         d = self.dut

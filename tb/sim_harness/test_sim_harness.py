@@ -101,8 +101,8 @@ def test_fst_window_is_small_and_exact(stream, tmp_path):
     assert f'[dumpfile] "{tmp_path / "line.fst"}"' in gtkw
     wanted = [ln for ln in gtkw.splitlines() if ln.startswith("TOP.")]
     for pe in (9, 10, 11):
-        assert any(f"g_chip[1].u_chip.g_pe[{pe - 9}].u_pe.c2_q" == w[-len(
-            f"g_chip[1].u_chip.g_pe[{pe - 9}].u_pe.c2_q"):] for w in wanted), pe
+        assert any(f"g_chip[1].u_chip.u_core.g_pe[{pe - 9}].u_pe.c2_q" == w[-len(
+            f"g_chip[1].u_chip.u_core.g_pe[{pe - 9}].u_pe.c2_q"):] for w in wanted), pe
     assert have_fst2vcd(), "fst2vcd (gtkwave) is needed: scripts/ensure_fst.sh"
     names, times = fst_names_and_times(tmp_path / "line.fst")
     missing = [w for w in wanted if w not in names]
@@ -110,7 +110,7 @@ def test_fst_window_is_small_and_exact(stream, tmp_path):
     assert min(times) == 10 * lo and max(times) == 10 * hi + 10, (min(times), max(times))
     # Only the chip of the shown PEs is dumped (plus the top and array levels).
     assert not any(".g_chip[0]." in n for n in names)
-    assert any(".g_chip[1].u_chip.g_pe[0].u_pe.a_q" in n for n in names)
+    assert any(".g_chip[1].u_chip.u_core.g_pe[0].u_pe.a_q" in n for n in names)
 
 
 def test_trace_csv_equals_structural_model(stream, tmp_path):
