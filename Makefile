@@ -15,7 +15,7 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: test-first-run sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
@@ -103,6 +103,11 @@ sim: $(SETUP)
 sim-merge: $(SETUP)
 	$(ENV) cd sw && $(PY) -m diffengine.regress --merge $(if $(SHARDS),$(abspath $(SHARDS)),$(ROOT)/sim/out/shard-*-of-*)
 
+# The first-run proof (docs/pipeline.md section 4): removes liblz4-dev, then concurrent
+# set-up callers must all succeed and bring it back. Alone, never inside make test.
+test-first-run: $(SETUP)
+	$(ENV) cd tb && DE_TEST_REINSTALL=1 $(PY) -m pytest -q -s tools/test_system_packages.py
+
 # 10^7 random commands per array configuration through the RTL (hours on 2 cores).
 test-long: $(SETUP)
 	$(ENV) cd tb && N_COMMANDS=10000000 $(PY) -m pytest -q -s de_array/test_de_array_scoreboard.py
@@ -124,8 +129,9 @@ bench: $(SETUP)
 	$(ENV) $(PY) scripts/bench_model.py --write
 	$(ENV) $(PY) scripts/bench_yproc.py --write
 
+# QUICK=1: the 72-chip rates (and the baseline's, when built) and the stream only.
 bench-array: $(SETUP)
-	$(ENV) $(PY) scripts/bench_array.py --write
+	$(ENV) $(PY) scripts/bench_array.py --write $(if $(filter 1,$(QUICK)),--quick,)
 
 bench-span: $(SETUP)
 	$(ENV) $(PY) scripts/bench_span.py --write

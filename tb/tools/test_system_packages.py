@@ -79,6 +79,11 @@ def test_parallel_callers_all_succeed():
 
 def test_removed_package_comes_back_once_under_concurrent_callers():
     """(b) remove liblz4-dev, then the set-up step x3 and ensure_fst.sh --headers x3 at once."""
+    if os.environ.get("DE_TEST_REINSTALL") != "1":
+        # Inside `make test` other workers compile against the lz4 headers at the same
+        # time; removing them under their feet would fail those builds, not this step.
+        pytest.skip("removes a package other tests use while they run: run alone with "
+                    "`make test-first-run` (DE_TEST_REINSTALL=1)")
     if os.geteuid() != 0:
         pytest.skip("not root: cannot remove and reinstall a Debian package here")
     sim = subprocess.run(["apt-get", "-s", "remove", PKG], capture_output=True, text=True)
