@@ -50,6 +50,8 @@ class Array {
   Out step(const In& in);
 
   int num_chips() const { return num_chips_; }
+  // The pieces' own context (its scope table names head, chip<c>, tail).
+  VerilatedContext* context() const { return ctx_.get(); }
   static int compiled_num_pe();
   static int compiled_carry_bug();
 

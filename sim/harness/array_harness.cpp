@@ -33,6 +33,12 @@
 #ifdef DE_TRACE
 #include "verilated_fst_c.h"
 #include "verilated_syms.h"
+#include <map>
+#ifdef DE_FASTFWD
+#include "Vde_array__Syms.h"
+#include "Vde_array___024root.h"
+#include "de_fast.h"
+#endif
 #endif
 
 namespace {
@@ -228,7 +234,7 @@ std::vector<Instr> pad_stream(const std::vector<Instr>& prog, int n_pe, uint64_t
 
 struct Options {
   int width = 0, repeat = 1;
-  bool quiet = false, trace_pixels = false, list_ops = false;
+  bool quiet = false, trace_pixels = false, list_ops = false, no_ffwd = false;
   long long from = -1, to = -1, line = -1;
   std::string fst, pes_spec, csv;
   long long col = -1;
@@ -398,6 +404,94 @@ bool write_gtkw(const std::string& fst, const std::vector<int>& pes, uint64_t t0
 }
 #endif
 
+#if defined(DE_TRACE) && defined(DE_FASTFWD)
+// ---- fast-forward: run the fast array (sim/fast) up to the window, then hand its state to
+// this traced flat model (docs/simulation.md section 7.5) -----------------------------------
+// The flat scope of a register -> the piece scope that holds the same RTL instance:
+//   TOP.de_array.u_skew...                  head.de_fast_head.u_skew...
+//   TOP.de_array.g_chip[c].u_chip.u_core... c = 0: head...u_core...; else chip<c>...u_core...
+//   TOP.de_array.g_chip[c].u_chip.u_bound.. c = N-1: tail...u_bound...; else chip<c+1>...u_bound...
+//   TOP.de_array.u_deskew...                tail.de_fast_tail.u_deskew...
+//   TOP.de_array (coll_q, coll_d)           tail.de_fast_tail
+// Anything else in the flat model is wiring between those instances, recomputed by the
+// settle that follows.
+bool piece_of(const std::string& flat, int n_chips, std::string& key, bool& only_coll) {
+  static const std::string top = "TOP.de_array";
+  only_coll = false;
+  if (flat.compare(0, top.size(), top) != 0) return false;
+  const std::string rest = flat.substr(top.size());
+  if (rest.empty()) {
+    key = "tail";
+    only_coll = true;
+    return true;
+  }
+  if (rest.compare(0, 7, ".u_skew") == 0) return key = "head" + rest, true;
+  if (rest.compare(0, 9, ".u_deskew") == 0) return key = "tail" + rest, true;
+  if (rest.compare(0, 8, ".g_chip[") != 0) return false;
+  const size_t close = rest.find(']');
+  const int c = std::atoi(rest.c_str() + 8);
+  const std::string r2 = rest.substr(close + 1);  // ".u_chip..."
+  if (r2.compare(0, 14, ".u_chip.u_core") == 0) {
+    key = (c == 0 ? std::string("head") : "chip" + std::to_string(c)) + r2.substr(7);
+    return true;
+  }
+  if (r2.compare(0, 15, ".u_chip.u_bound") == 0) {
+    key = (c == n_chips - 1 ? std::string("tail") : "chip" + std::to_string(c + 1)) +
+          r2.substr(7);
+    return true;
+  }
+  return false;
+}
+
+// Copies every variable of every mapped scope; false (with err) when one has no twin.
+bool hand_over(de_fast::Array& fa, VerilatedContext& flat_ctx, Vde_array& top, int n_chips,
+               long& copied, std::string& err) {
+  std::map<std::string, const VerilatedScope*> pieces;  // "chip5.u_core.g_pe[0].u_pe" -> scope
+  for (const auto& kv : *fa.context()->scopeNameMap()) {
+    const std::string n = kv.first;  // "<model>.de_fast_<kind><rest>"
+    const size_t dot = n.find('.');
+    if (dot == std::string::npos) continue;
+    if (n.compare(dot + 1, 8, "de_fast_") != 0) continue;  // e.g. the de_pkg scope
+    const size_t dot2 = n.find('.', dot + 1);
+    pieces[n.substr(0, dot) + (dot2 == std::string::npos ? "" : n.substr(dot2))] = kv.second;
+  }
+  copied = 0;
+  for (const auto& kv : *flat_ctx.scopeNameMap()) {
+    std::string key;
+    bool only_coll = false;
+    if (!piece_of(kv.first, n_chips, key, only_coll)) continue;
+    const auto it = pieces.find(key);
+    if (it == pieces.end()) {
+      err = "fast-forward: no piece scope " + key + " for " + kv.first;
+      return false;
+    }
+    const VerilatedVarNameMap* vars = kv.second->varsp();
+    if (!vars) continue;
+    for (const auto& v : *vars) {
+      const std::string name = v.first;
+      if (only_coll && name != "coll_q" && name != "coll_d") continue;
+      VerilatedVar* dst = kv.second->varFind(name.c_str());
+      if (dst->isParam() || !dst->datap()) continue;  // parameters live in constant storage
+      // The clock: the pieces stop with it low, this model with it high; copying it would
+      // make the settle below see a rising edge in every chip.
+      if (name == "clk_i") continue;
+      VerilatedVar* src = it->second->varFind(name.c_str());
+      if (!src || src->totalSize() != dst->totalSize()) {
+        err = std::string("fast-forward: ") + kv.first + "." + name + " has no twin in " + key;
+        return false;
+      }
+      std::memcpy(dst->datap(), src->datap(), dst->totalSize());
+      ++copied;
+    }
+  }
+  // Settle the wiring from the copied state: the model evaluates as on its first call
+  // (initial + settle; the RTL has no initial blocks, registers are set at construction).
+  top.rootp->vlSymsp->__Vm_didInit = false;
+  top.eval();
+  return true;
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -406,7 +500,8 @@ int main(int argc, char** argv) {
                  "usage: %s IN.(de48|cmd|de32) OUT.depx [--width N] [--repeat K] [--quiet]\n"
                  "  [--trace-pixels] [--list-ops] [--from-cycle C] [--to-cycle C] [--line L]\n"
                  "  [--fst FILE.fst] [--col Q] [--trace-pes LIST] [--trace-csv FILE|-]\n"
-                 "  [--break-cycle C] [--break-line L] [--break-pe P --break-op OP]\n",
+                 "  [--break-cycle C] [--break-line L] [--break-pe P --break-op OP]\n"
+                 "  [--no-fast-forward]\n",
                  argv[0]);
     return 2;
   }
@@ -436,6 +531,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(a, "--quiet")) o.quiet = true;
     else if (!std::strcmp(a, "--trace-pixels")) o.trace_pixels = true;
     else if (!std::strcmp(a, "--list-ops")) o.list_ops = true;
+    else if (!std::strcmp(a, "--no-fast-forward")) o.no_ffwd = true;
     else if (!std::strcmp(a, "--from-cycle")) num(o.from);
     else if (!std::strcmp(a, "--to-cycle")) num(o.to);
     else if (!std::strcmp(a, "--line")) num(o.line);
@@ -642,8 +738,55 @@ int main(int argc, char** argv) {
   const bool slow = o.tracing();
   auto t0 = std::chrono::steady_clock::now();
   uint64_t cycle = 0;
+  uint64_t first_i = 0;  // where the first repeat starts in the flat model
+#if defined(DE_TRACE) && defined(DE_FASTFWD)
+  // Nothing is observed before the window (or the breakpoint cycle), so those cycles run
+  // in the fast array; an opcode breakpoint watches every cycle and turns this off.
+  uint64_t ffwd = (!o.fst.empty() || !o.csv.empty()) ? w_from : UINT64_MAX;
+  ffwd = std::min(ffwd, break_at);
+  if (ffwd == UINT64_MAX || o.no_ffwd || o.break_pe >= 0 || !slow) ffwd = 0;
+  ffwd = std::min<uint64_t>(ffwd, play);
+  if (ffwd > 0) {
+    const auto f0 = std::chrono::steady_clock::now();
+    de_fast::Array fa(n_chips, kPePerChip, de_fast::Array::compiled_carry_bug());
+    de_fast::In rin;
+    rin.rst = true;
+    for (int k = 0; k < 4; ++k) fa.step(rin);
+    de_fast::Out fo;
+    for (uint64_t i = 0; i < ffwd; ++i) {
+      de_fast::In in;
+      in.ident = seq[i].ident;
+      in.data = seq[i].data;
+      fo = fa.step(in);
+      if (fo.pixel_valid) pixels.push_back(fo.pixel);
+      if (o.trace_pixels && fo.pixel_valid)
+        std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(i + 1),
+                    pixels.size() - 1, fo.pixel);
+      if (o.trace_pixels && seq[i].ident == kRefresh)
+        std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(i + 1));
+      if (fo.collision && !collided) {
+        collided = true;
+        std::fprintf(stderr, "%s: pixel collision at cycle %llu\n", argv[1],
+                     static_cast<unsigned long long>(i + 1));
+      }
+    }
+    long copied = 0;
+    if (!hand_over(fa, *ctx, *top, n_chips, copied, err)) {
+      std::fprintf(stderr, "%s: %s\n", argv[0], err.c_str());
+      return 1;
+    }
+    first_i = cycle = ffwd;
+    std::fprintf(stderr, "harness: fast-forward %llu cycles in the fast array (%.2f s), %ld "
+                 "variables handed to the traced model\n",
+                 static_cast<unsigned long long>(ffwd),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - f0).count(),
+                 copied);
+  }
+  // The pieces made their own context the thread's current one; it is gone now.
+  Verilated::threadContextp(ctx.get());
+#endif
   for (int r = 0; r < o.repeat; ++r) {
-    for (uint64_t i = 0; i < play; ++i, ++cycle) {
+    for (uint64_t i = r == 0 ? first_i : 0; i < play; ++i, ++cycle) {
       const Instr& in = seq[i];
       top->ident_i = in.ident;
       top->data_i = in.data;

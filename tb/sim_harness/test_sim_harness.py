@@ -225,3 +225,44 @@ def test_cmd_input_is_assembled(tmp_path):
     bad.write_text("Frobnicate (1);\n")
     res = run(exe, bad, tmp_path / "b.depx", rc=1)
     assert "diffengine asm" in res.stderr and "bad.cmd" in res.stderr
+
+
+def _vcd_body(fst: Path) -> str:
+    out = subprocess.run(["fst2vcd", str(fst)], capture_output=True, text=True,
+                         check=True, stdin=subprocess.DEVNULL).stdout
+    return out[out.index("$enddefinitions"):]  # without the header's date
+
+
+@pytest.mark.parametrize("bug", [0, 1])
+def test_fast_forward_hands_over_exactly(seed, tmp_path, bug):
+    """The trace build runs the cycles before its window in the fast array and hands the
+    state to the traced flat model (docs/simulation.md 7.5): the window's FST, the trace
+    CSV, the frame and a line breakpoint are identical to a run that simulates every cycle
+    in the traced model (--no-fast-forward). Many lines, so the hand-over is deep in the
+    stream and spans cross the chip boundary."""
+    from diffengine import randgen
+
+    assert have_fst2vcd(), "fst2vcd (gtkwave) is needed: scripts/ensure_fst.sh"
+    cmds = randgen.stream(seed, 500, N_PE, (1, 40))
+    src = tmp_path / "s.de48"
+    src.write_bytes(binfmt.encode_de48(isa.serialise(cmds)))
+    lines = len(isa.split_lines(cmds))
+    line = max(2, lines * 2 // 3)
+    exe = harness_exe(bug)
+    out = {}
+    for mode, extra in (("ff", []), ("full", ["--no-fast-forward"])):
+        fst, csv, frame = (tmp_path / f"{mode}.fst", tmp_path / f"{mode}.csv",
+                           tmp_path / f"{mode}.depx")
+        res = run(exe, src, frame, "--line", line, "--fst", fst, "--col", 9,
+                  "--trace-pes", "7-10", "--trace-csv", csv, *extra)
+        brk = run(exe, src, tmp_path / f"{mode}_b.depx", "--break-line", line - 1, *extra,
+                  rc=3)
+        out[mode] = (res.stderr, _vcd_body(fst), csv.read_text(), frame.read_bytes(),
+                     brk.stdout, brk.stderr)
+    assert "fast-forward" in out["ff"][0] and "fast-forward" not in out["full"][0]
+    assert "fast-forward" in out["ff"][5]
+    assert out["ff"][1] == out["full"][1], f"seed {seed}: window FST differs"
+    assert out["ff"][2] == out["full"][2], f"seed {seed}: trace CSV differs"
+    assert out["ff"][3] == out["full"][3], f"seed {seed}: frame differs"
+    assert out["ff"][4] == out["full"][4], f"seed {seed}: breakpoint print-out differs"
+    assert len(out["ff"][2].splitlines()) > 4 * 10
