@@ -109,8 +109,10 @@ test-first-run: $(SETUP)
 	$(ENV) cd tb && DE_TEST_REINSTALL=1 $(PY) -m pytest -q -s tools/test_system_packages.py
 
 # 10^7 random commands per array configuration through the RTL (hours on 2 cores).
+# J parallel workers (default 2); each configuration prints its seed (-rP shows it).
 test-long: $(SETUP)
-	$(ENV) cd tb && N_COMMANDS=10000000 $(PY) -m pytest -q -s de_array/test_de_array_scoreboard.py
+	$(ENV) cd tb && N_COMMANDS=10000000 $(PY) -m pytest -q -rP -n $(J) --durations=0 \
+	  de_array/test_de_array_scoreboard.py
 
 waves: $(SETUP)
 	@./scripts/ensure_fst.sh
