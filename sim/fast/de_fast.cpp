@@ -7,8 +7,14 @@
 #include <stdexcept>
 
 #include "Vde_fast_head.h"
+#include "Vde_fast_head__Syms.h"
+#include "Vde_fast_head___024root.h"
 #include "Vde_fast_tail.h"
+#include "Vde_fast_tail__Syms.h"
+#include "Vde_fast_tail___024root.h"
 #include "Vde_fast_unit.h"
+#include "Vde_fast_unit__Syms.h"
+#include "Vde_fast_unit___024root.h"
 #include "svdpi.h"
 #include "verilated.h"
 
@@ -45,6 +51,17 @@ Array::Array(int num_chips, int num_pe, int carry_bug) : num_chips_(num_chips) {
   }
   tail_->clk_i = 0;
   tail_->eval();
+}
+
+void Array::settle() {
+  head_->rootp->vlSymsp->__Vm_didInit = false;
+  head_->eval_step();
+  for (auto& u : units_) {
+    u->rootp->vlSymsp->__Vm_didInit = false;
+    u->eval_step();
+  }
+  tail_->rootp->vlSymsp->__Vm_didInit = false;
+  tail_->eval_step();
 }
 
 Array::~Array() {

@@ -50,6 +50,9 @@ class Array {
   Out step(const In& in);
 
   int num_chips() const { return num_chips_; }
+  // Re-evaluates every piece as on its first call (after registers were written from
+  // outside, sim/harness fast-forward): the wiring follows the registers again.
+  void settle();
   // The pieces' own context (its scope table names head, chip<c>, tail).
   VerilatedContext* context() const { return ctx_.get(); }
   static int compiled_num_pe();

@@ -6,8 +6,8 @@
 #   $(FAST_VFLAGS) include paths and the compiled NumPe/CarryBug for $(FAST_CPP)
 # The pieces depend only on the chip RTL and CARRY_BUG, so every array size and the
 # display controller share one set (sim/build/fast_b<CARRY_BUG>).
-# FAST_PUBLIC=1: the pieces with --public-flat-rw, for the trace build's fast-forward
-# (docs/simulation.md 7.5), in their own folder.
+# FAST_PUBLIC=1: the pieces with their registers public (sim/fast/public_regs.vlt), for the
+# trace build's fast-forward (docs/simulation.md 7.5), in their own folder.
 FAST_PUBLIC ?= 0
 FAST_DIR := $(ROOT)/sim/build/fast_b$(CARRY_BUG)$(if $(filter 1,$(FAST_PUBLIC)),_pub,)
 FAST_SHELL := $(ROOT)/sim/fast/de_array_dpi.sv
@@ -22,5 +22,5 @@ fast-pieces:
 	@mkdir -p $(ROOT)/sim/build
 	@flock $(FAST_DIR).lock $(MAKE) -s -j 3 -f $(ROOT)/sim/fast/pieces.mk \
 	  FASTDIR=$(FAST_DIR) CARRY_BUG=$(CARRY_BUG) \
-	  VEXTRA="$(if $(filter 1,$(FAST_PUBLIC)),--public-flat-rw,)"
+	  VEXTRA="$(if $(filter 1,$(FAST_PUBLIC)),$(ROOT)/sim/fast/public_regs.vlt,)"
 

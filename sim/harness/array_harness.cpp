@@ -443,9 +443,18 @@ bool piece_of(const std::string& flat, int n_chips, std::string& key, bool& only
   return false;
 }
 
-// Copies every variable of every mapped scope; false (with err) when one has no twin.
+bool is_register(const std::string& name) {
+  const size_t n = name.size();
+  return (n > 2 && name.compare(n - 2, 2, "_q") == 0) ||
+         (n > 3 && name.compare(n - 3, 3, "_q2") == 0);
+}
+
+// Copies every register (the *_q / *_q2 variables, public in both models) between the
+// fast array and this model, in the direction asked, then settles the receiver's wiring
+// as on its first evaluation. A register of a mapped flat scope without a twin in its
+// piece is an error, not a skip.
 bool hand_over(de_fast::Array& fa, VerilatedContext& flat_ctx, Vde_array& top, int n_chips,
-               long& copied, std::string& err) {
+               bool to_flat, long& copied, std::string& err) {
   std::map<std::string, const VerilatedScope*> pieces;  // "chip5.u_core.g_pe[0].u_pe" -> scope
   for (const auto& kv : *fa.context()->scopeNameMap()) {
     const std::string n = kv.first;  // "<model>.de_fast_<kind><rest>"
@@ -460,34 +469,33 @@ bool hand_over(de_fast::Array& fa, VerilatedContext& flat_ctx, Vde_array& top, i
     std::string key;
     bool only_coll = false;
     if (!piece_of(kv.first, n_chips, key, only_coll)) continue;
-    const auto it = pieces.find(key);
-    if (it == pieces.end()) {
-      err = "fast-forward: no piece scope " + key + " for " + kv.first;
-      return false;
-    }
     const VerilatedVarNameMap* vars = kv.second->varsp();
     if (!vars) continue;
+    const auto it = pieces.find(key);
     for (const auto& v : *vars) {
       const std::string name = v.first;
-      if (only_coll && name != "coll_q" && name != "coll_d") continue;
-      VerilatedVar* dst = kv.second->varFind(name.c_str());
-      if (dst->isParam() || !dst->datap()) continue;  // parameters live in constant storage
-      // The clock: the pieces stop with it low, this model with it high; copying it would
-      // make the settle below see a rising edge in every chip.
-      if (name == "clk_i") continue;
-      VerilatedVar* src = it->second->varFind(name.c_str());
-      if (!src || src->totalSize() != dst->totalSize()) {
-        err = std::string("fast-forward: ") + kv.first + "." + name + " has no twin in " + key;
+      if (!is_register(name) || (only_coll && name != "coll_q")) continue;
+      VerilatedVar* fv = kv.second->varFind(name.c_str());
+      if (fv->isParam() || !fv->datap()) continue;
+      VerilatedVar* pv = it == pieces.end() ? nullptr : it->second->varFind(name.c_str());
+      if (!pv || pv->totalSize() != fv->totalSize()) {
+        err = std::string("fast-forward: register ") + kv.first + "." + name +
+              " has no twin in piece scope " + key;
         return false;
       }
-      std::memcpy(dst->datap(), src->datap(), dst->totalSize());
+      if (to_flat) std::memcpy(fv->datap(), pv->datap(), fv->totalSize());
+      else std::memcpy(pv->datap(), fv->datap(), fv->totalSize());
       ++copied;
     }
   }
-  // Settle the wiring from the copied state: the model evaluates as on its first call
-  // (initial + settle; the RTL has no initial blocks, registers are set at construction).
-  top.rootp->vlSymsp->__Vm_didInit = false;
-  top.eval();
+  if (to_flat) {
+    // Settle the wiring from the registers: the model evaluates as on its first call
+    // (initial + settle; the RTL has no initial blocks, registers are set at construction).
+    top.rootp->vlSymsp->__Vm_didInit = false;
+    top.eval();
+  } else {
+    fa.settle();
+  }
   return true;
 }
 #endif
@@ -740,6 +748,7 @@ int main(int argc, char** argv) {
   uint64_t cycle = 0;
   uint64_t first_i = 0;  // where the first repeat starts in the flat model
 #if defined(DE_TRACE) && defined(DE_FASTFWD)
+  std::unique_ptr<de_fast::Array> fa;  // the fast array, while it holds the state
   // Nothing is observed before the window (or the breakpoint cycle), so those cycles run
   // in the fast array; an opcode breakpoint watches every cycle and turns this off.
   uint64_t ffwd = (!o.fst.empty() || !o.csv.empty()) ? w_from : UINT64_MAX;
@@ -748,16 +757,17 @@ int main(int argc, char** argv) {
   ffwd = std::min<uint64_t>(ffwd, play);
   if (ffwd > 0) {
     const auto f0 = std::chrono::steady_clock::now();
-    de_fast::Array fa(n_chips, kPePerChip, de_fast::Array::compiled_carry_bug());
+    fa = std::make_unique<de_fast::Array>(n_chips, kPePerChip,
+                                          de_fast::Array::compiled_carry_bug());
     de_fast::In rin;
     rin.rst = true;
-    for (int k = 0; k < 4; ++k) fa.step(rin);
+    for (int k = 0; k < 4; ++k) fa->step(rin);
     de_fast::Out fo;
     for (uint64_t i = 0; i < ffwd; ++i) {
       de_fast::In in;
       in.ident = seq[i].ident;
       in.data = seq[i].data;
-      fo = fa.step(in);
+      fo = fa->step(in);
       if (fo.pixel_valid) pixels.push_back(fo.pixel);
       if (o.trace_pixels && fo.pixel_valid)
         std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(i + 1),
@@ -771,7 +781,7 @@ int main(int argc, char** argv) {
       }
     }
     long copied = 0;
-    if (!hand_over(fa, *ctx, *top, n_chips, copied, err)) {
+    if (!hand_over(*fa, *ctx, *top, n_chips, true, copied, err)) {
       std::fprintf(stderr, "%s: %s\n", argv[0], err.c_str());
       return 1;
     }
@@ -782,8 +792,13 @@ int main(int argc, char** argv) {
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - f0).count(),
                  copied);
   }
-  // The pieces made their own context the thread's current one; it is gone now.
+  // The pieces made their own context the thread's current one.
   Verilated::threadContextp(ctx.get());
+  // After a window with nothing to watch beyond it, the rest runs in the fast array again.
+  const uint64_t back_at = (fa && o.repeat == 1 && (!o.fst.empty() || !o.csv.empty()) &&
+                            o.break_pe < 0 && break_at == UINT64_MAX && w_to + 1 < play)
+                               ? w_to : UINT64_MAX;
+  bool handed_back = false;
 #endif
   for (int r = 0; r < o.repeat; ++r) {
     for (uint64_t i = r == 0 ? first_i : 0; i < play; ++i, ++cycle) {
@@ -854,10 +869,53 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s: pixel collision at cycle %llu\n", argv[1],
                      static_cast<unsigned long long>(cycle + 1));
       }
+#if defined(DE_TRACE) && defined(DE_FASTFWD)
+      if (cycle == back_at) {
+        const auto b0 = std::chrono::steady_clock::now();
+        long copied = 0;
+        if (!hand_over(*fa, *ctx, *top, n_chips, false, copied, err)) {
+          std::fprintf(stderr, "%s: %s\n", argv[0], err.c_str());
+          return 1;
+        }
+        Verilated::threadContextp(ctx.get());
+        de_fast::Out fo;
+        for (uint64_t k = i + 1; k < play; ++k) {
+          de_fast::In in;
+          in.ident = seq[k].ident;
+          in.data = seq[k].data;
+          fo = fa->step(in);
+          if (fo.pixel_valid) pixels.push_back(fo.pixel);
+          if (o.trace_pixels && fo.pixel_valid)
+            std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(k + 1),
+                        pixels.size() - 1, fo.pixel);
+          if (o.trace_pixels && seq[k].ident == kRefresh)
+            std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(k + 1));
+          if (fo.collision && !collided) {
+            collided = true;
+            std::fprintf(stderr, "%s: pixel collision at cycle %llu\n", argv[1],
+                         static_cast<unsigned long long>(k + 1));
+          }
+        }
+        handed_back = true;
+        std::fprintf(stderr, "harness: after the window, %llu cycles back in the fast array "
+                     "(%.2f s)\n", static_cast<unsigned long long>(play - i - 1),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - b0)
+                         .count());
+        cycle = play - 1;
+        break;
+      }
+#endif
     }
   }
   (void)slow;
-  if (top->pix_collision_o) {
+  bool collision_at_end = top->pix_collision_o;
+#if defined(DE_TRACE) && defined(DE_FASTFWD)
+  if (handed_back) {
+    ++cycle;  // the loop's own increment was skipped by the break
+    collision_at_end = collided;
+  }
+#endif
+  if (collision_at_end) {
     std::fprintf(stderr, "%s: pixel collision in the array (Refreshes too close)\n", argv[1]);
     return 1;
   }

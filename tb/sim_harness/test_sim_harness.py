@@ -260,6 +260,7 @@ def test_fast_forward_hands_over_exactly(seed, tmp_path, bug):
         out[mode] = (res.stderr, _vcd_body(fst), csv.read_text(), frame.read_bytes(),
                      brk.stdout, brk.stderr)
     assert "fast-forward" in out["ff"][0] and "fast-forward" not in out["full"][0]
+    assert "after the window" in out["ff"][0]  # and back to the fast array for the rest
     assert "fast-forward" in out["ff"][5]
     assert out["ff"][1] == out["full"][1], f"seed {seed}: window FST differs"
     assert out["ff"][2] == out["full"][2], f"seed {seed}: trace CSV differs"
