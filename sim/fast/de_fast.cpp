@@ -73,6 +73,16 @@ Array::~Array() {
 namespace {
 // A rising edge, then the clock low again (ready for the next edge). Between the two
 // evaluations nothing changes: the second one only re-arms the edge detector.
+// A piece takes its upstream neighbour's chip-core outputs (bus, pixel chain, collision).
+template <class Dst, class Src>
+inline void take_bus(Dst& d, const Src& s) {
+  d.id_i = s.id_o;
+  d.data_i = s.data_o;
+  d.pix_valid_i = s.pix_valid_o;
+  d.pix_i = s.pix_o;
+  d.coll_i = s.coll_o;
+}
+
 template <class M>
 inline void edge(M& m) {
   m.clk_i = 1;
@@ -101,20 +111,8 @@ Out Array::step(const In& in) {
   for (auto& u : units_) coll_others |= u->prev_coll_o;
   t.rst_i = in.rst;
   t.coll_others_i = coll_others;
-  if (units_.empty()) {
-    t.id_i = h.id_o;
-    t.data_i = h.data_o;
-    t.pix_valid_i = h.pix_valid_o;
-    t.pix_i = h.pix_o;
-    t.coll_i = h.coll_o;
-  } else {
-    Vde_fast_unit& l = *units_.back();
-    t.id_i = l.id_o;
-    t.data_i = l.data_o;
-    t.pix_valid_i = l.pix_valid_o;
-    t.pix_i = l.pix_o;
-    t.coll_i = l.coll_o;
-  }
+  if (units_.empty()) take_bus(t, h);
+  else take_bus(t, *units_.back());
   edge(t);
 
   for (size_t k = units_.size(); k-- > 0;) {
@@ -124,20 +122,12 @@ Out Array::step(const In& in) {
     u.obs_load_i = in.obs_load;
     u.obs_shift_i = in.obs_shift;
     if (k == 0) {
-      u.id_i = h.id_o;
-      u.data_i = h.data_o;
-      u.pix_valid_i = h.pix_valid_o;
-      u.pix_i = h.pix_o;
-      u.coll_i = h.coll_o;
+      take_bus(u, h);
       u.cfg_bit_i = h.cfg_bit_o;
       u.obs_bit_i = h.obs_bit_o;
     } else {
       const Vde_fast_unit& p = *units_[k - 1];
-      u.id_i = p.id_o;
-      u.data_i = p.data_o;
-      u.pix_valid_i = p.pix_valid_o;
-      u.pix_i = p.pix_o;
-      u.coll_i = p.coll_o;
+      take_bus(u, p);
       u.cfg_bit_i = p.cfg_bit_o;
       u.obs_bit_i = p.obs_bit_o;
     }
