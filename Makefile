@@ -111,7 +111,7 @@ test-first-run: $(SETUP)
 # 10^7 random commands per array configuration through the RTL (hours on 2 cores).
 # J parallel workers (default 2); each configuration prints its seed (-rP shows it).
 test-long: $(SETUP)
-	$(ENV) cd tb && N_COMMANDS=10000000 $(PY) -m pytest -q -rP -n $(J) --durations=0 \
+	$(ENV) cd tb && N_COMMANDS=10000000 $(PY) -m pytest -v -rP -n $(J) --durations=0 \
 	  de_array/test_de_array_scoreboard.py
 
 waves: $(SETUP)
