@@ -1,5 +1,5 @@
 // Fast simulation of de_array: the composed model (de_fast.h) and the DPI functions the
-// shell sim/fast/de_array_dpi.sv calls. docs/simulation.md explains the cut and why.
+// shell sim/fast/de_array.sv calls. docs/simulation.md explains the cut and why.
 #include "de_fast.h"
 
 #include <cstdio>
@@ -157,7 +157,7 @@ Out Array::step(const In& in) {
 
 }  // namespace de_fast
 
-// ---- DPI: the shell sim/fast/de_array_dpi.sv -----------------------------------------
+// ---- DPI: the shell sim/fast/de_array.sv -----------------------------------------
 extern "C" void* de_fast_new(int num_chips, int num_pe, int carry_bug, const char* scope) {
   try {
     return new de_fast::Array(num_chips, num_pe, carry_bug);

@@ -10,7 +10,7 @@
 # trace build's fast-forward (docs/simulation.md 7.5), in their own folder.
 FAST_PUBLIC ?= 0
 FAST_DIR := $(ROOT)/sim/build/fast_b$(CARRY_BUG)$(if $(filter 1,$(FAST_PUBLIC)),_pub,)
-FAST_SHELL := $(ROOT)/sim/fast/de_array_dpi.sv
+FAST_SHELL := $(ROOT)/sim/fast/de_array.sv
 FAST_CPP := $(ROOT)/sim/fast/de_fast.cpp
 FAST_LIBS := $(foreach p,head unit tail,$(FAST_DIR)/$(p)/Vde_fast_$(p)__ALL.a)
 FAST_VFLAGS := -CFLAGS "-I$(FAST_DIR)/head -I$(FAST_DIR)/unit -I$(FAST_DIR)/tail \

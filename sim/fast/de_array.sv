@@ -6,7 +6,6 @@
 // ports. Built instead of rtl/array/de_array.sv by the fast harness builds only
 // (sim/Makefile, sim/dc/Makefile with FAST=1); sim/fast/equiv.cpp checks the two against
 // each other every cycle.
-/* verilator lint_off DECLFILENAME */
 module de_array
   import de_pkg::*;
 #(
@@ -47,8 +46,11 @@ module de_array
   chandle h;
   initial h = de_fast_new(NumChips, NumPe, CarryBug, $sformatf("%m"));
 
+  // The DPI carries fixed C types; only the low IdW/PixW/DataW bits are the array's.
+  /* verilator lint_off UNUSEDSIGNAL */
   int          s_id, s_pix;
   longint      s_data;
+  /* verilator lint_on UNUSEDSIGNAL */
   bit          s_pixv, s_coll, s_cfg, s_obs;
   logic [IdW-1:0]   id_q;
   logic [DataW-1:0] data_q;
