@@ -18,7 +18,9 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 CYCLES = int(os.environ.get("EQUIV_CYCLES", 200_000))
-CONFIGS = [(1, 0), (2, 0), (2, 1), (3, 1), (8, 0)]
+# 1 chip (head + tail only), 2 chips with the carry bug (one unit), 8 chips (units feeding
+# units); each is a flat Verilator build of its own, so make test keeps to three.
+CONFIGS = [(1, 0), (2, 1), (8, 0)]
 
 
 def build(chips: int, bug: int) -> Path:
