@@ -458,7 +458,9 @@ async def test_shell_serialiser(dut):
     pll.clkos_r.value = 0
     phase_ps = rng.randrange(0, 8000, 250)
     cocotb.start_soon(Clock(pll.clkos_r, 40, unit="ns").start())
-    await Timer(phase_ps, unit="ps")
+    # cocotb 2 refuses Timer(0): phase 0 starts both clocks together (1 seed in 32).
+    if phase_ps:
+        await Timer(phase_ps, unit="ps")
     cocotb.start_soon(Clock(pll.clkop_r, 8, unit="ns").start())
     await ClockCycles(pll.clkos_r, 4)
     pll.lock_r.value = 1
