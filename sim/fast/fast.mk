@@ -9,6 +9,9 @@
 # FAST_PUBLIC=1: the pieces with their registers public (sim/fast/public_regs.vlt), for the
 # trace build's fast-forward (docs/simulation.md 7.5), in their own folder.
 FAST_PUBLIC ?= 0
+# FAST_PGO=0: pieces without the profile-guided second compile (sim/fast/pieces.mk); the
+# public variant is never trained (it only fast-forwards trace builds).
+FAST_PGO ?= 1
 FAST_DIR := $(ROOT)/sim/build/fast_b$(CARRY_BUG)$(if $(filter 1,$(FAST_PUBLIC)),_pub,)
 FAST_SHELL := $(ROOT)/sim/fast/de_array.sv
 FAST_CPP := $(ROOT)/sim/fast/de_fast.cpp
@@ -21,6 +24,6 @@ FAST_VFLAGS := -CFLAGS "-I$(FAST_DIR)/head -I$(FAST_DIR)/unit -I$(FAST_DIR)/tail
 fast-pieces:
 	@mkdir -p $(ROOT)/sim/build
 	@flock $(FAST_DIR).lock $(MAKE) -s -j 3 -f $(ROOT)/sim/fast/pieces.mk \
-	  FASTDIR=$(FAST_DIR) CARRY_BUG=$(CARRY_BUG) \
+	  FASTDIR=$(FAST_DIR) CARRY_BUG=$(CARRY_BUG) FAST_PGO=$(if $(filter 1,$(FAST_PUBLIC)),0,$(FAST_PGO)) \
 	  VEXTRA="$(if $(filter 1,$(FAST_PUBLIC)),$(ROOT)/sim/fast/public_regs.vlt,)"
 

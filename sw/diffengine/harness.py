@@ -80,12 +80,22 @@ def run(commands: list[isa.Command] | None, chips: int, carry_bug: bool = False,
         slots=None, threads: int | None = None, extra_args: tuple[str, ...] = (),
         trace: bool = False) -> tuple[np.ndarray, str]:
     """Play commands (or raw slots) through the array; returns (frame, harness report)."""
-    exe = build(chips, carry_bug, threads, trace)
     if slots is None:
         slots = isa.serialise(commands)
     with tempfile.TemporaryDirectory() as tmp:
-        src, dst = Path(tmp) / "in.de48", Path(tmp) / "out.depx"
+        src = Path(tmp) / "in.de48"
         src.write_bytes(binfmt.encode_de48(slots))
+        return run_file(src, chips, carry_bug, threads=threads, extra_args=extra_args,
+                        trace=trace)
+
+
+def run_file(src: Path, chips: int, carry_bug: bool = False, threads: int | None = None,
+             extra_args: tuple[str, ...] = (), trace: bool = False) -> tuple[np.ndarray, str]:
+    """Play a .de48 file through the array (streams too long to hold as Python objects);
+    returns (frame, harness report)."""
+    exe = build(chips, carry_bug, threads, trace)
+    with tempfile.TemporaryDirectory() as tmp:
+        dst = Path(tmp) / "out.depx"
         res = subprocess.run([str(exe), str(src), str(dst), *extra_args],
                              capture_output=True, text=True)
         if res.returncode:

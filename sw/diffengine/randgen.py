@@ -79,10 +79,25 @@ def command(rng: random.Random, width: int) -> isa.Command:
 def stream(seed: int, n_commands: int, width: int, per_line: tuple[int, int] = (1, 40)
            ) -> list[isa.Command]:
     """`n_commands` random commands (Refreshes included) in lines of random length."""
+    return [c for chunk in chunks(seed, n_commands, width, per_line, n_commands)
+            for c in chunk]
+
+
+def chunks(seed: int, n_commands: int, width: int, per_line: tuple[int, int] = (1, 40),
+           chunk: int = 200_000):
+    """stream(seed, n_commands, ...) in pieces of whole lines, about `chunk` commands each
+    (each piece ends with a Refresh): the same commands, without holding them all, for
+    streams too long to keep as Python objects (make test-long: 10^7 commands)."""
     rng = random.Random(seed)
     out: list[isa.Command] = []
-    while len(out) < n_commands:
+    done = 0
+    while done + len(out) < n_commands:
         for _ in range(rng.randint(*per_line)):
             out.append(command(rng, width))
         out.append(isa.Command("REFRESH"))
-    return out
+        if len(out) >= chunk:
+            done += len(out)
+            yield out
+            out = []
+    if out:
+        yield out
