@@ -48,6 +48,7 @@ SOURCES := $(RTL) $(foreach p,head unit tail,$(ROOT)/sim/fast/de_fast_$(p).sv) \
 $(PROF)/trained.stamp: $(SOURCES) $(ROOT)/sim/fast/train_stream.py
 	@echo "fast pieces (CarryBug=$(CARRY_BUG)): instrumented build and training run for the profile ..."
 	@rm -rf $(PROF) $(FASTDIR)/gen $(FASTDIR)/train
+	@mkdir -p $(PROF)
 	@$(MAKE) -s -C $(ROOT)/sim harness CHIPS=72 CARRY_BUG=$(CARRY_BUG) THREADS=1 TRACE=0 FLAT=0 \
 	  FAST_PGO=0 FAST_DIR=$(FASTDIR)/gen BUILD=$(FASTDIR)/train FAST_CFLAGS="$(GEN_CFLAGS)" \
 	  FAST_LDFLAGS=-fprofile-generate > $(FASTDIR)/train.log 2>&1 \
