@@ -77,7 +77,14 @@ static void bary(const double *a, const double *b, const double *c, const double
     w[0] = 1 - w[1] - w[2];
 }
 
-static void face_point_normal(const yp_shader *s, int fi, const double *P, double *N)
+/* The shading point and normal for world point P on face fi's plane. P is where the ray
+ * through a pixel centre meets the plane, and for a pixel the face only partly covers that
+ * is often outside the face: interpolated there, the vertex normals extrapolate, and on a
+ * sliver with grazing normals the extrapolated one can face the other way, so the
+ * two-sided test leaves the face unlit (short dark streaks along the teapot's rims;
+ * docs/yproc.md). So the barycentric weights are clamped to the face (negative weights to
+ * 0, then normalised) and P moves with them onto the face. */
+static void face_point_normal(const yp_shader *s, int fi, double *P, double *N)
 {
     const hsr_scene *sc = s->sc;
     const hsr_face *F = &sc->f[fi];
@@ -90,6 +97,13 @@ static void face_point_normal(const yp_shader *s, int fi, const double *P, doubl
         bary(vtx(sc, fi, 0), vtx(sc, fi, i), vtx(sc, fi, i + 1), P, w);
         double mn = fmin(w[0], fmin(w[1], w[2]));
         if (mn > best) { best = mn; bi = i; memcpy(bw, w, sizeof bw); }
+    }
+    if (best < 0) {
+        double sum = 0;
+        for (int k = 0; k < 3; k++) sum += bw[k] = fmax(bw[k], 0);
+        for (int k = 0; k < 3; k++) bw[k] /= sum;   /* sum > 0: at most two weights are < 0 */
+        const double *a = vtx(sc, fi, 0), *b = vtx(sc, fi, bi), *c = vtx(sc, fi, bi + 1);
+        for (int k = 0; k < 3; k++) P[k] = bw[0] * a[k] + bw[1] * b[k] + bw[2] * c[k];
     }
     const int *fv = &sc->fv[F->first];
     for (int k = 0; k < 3; k++)

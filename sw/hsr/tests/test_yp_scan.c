@@ -429,6 +429,60 @@ static void test_yp_anim_incremental_equals_full_rebuild(void)
 
 /* values at the ends of the range never wrap: white on white and near
  * black on black, with edges and ramps that need fitting */
+/* Phong shades a face once per pixel, at the pixel centre. A sliver thinner than a pixel
+ * often misses every centre; there the vertex normals used to be extrapolated, and with
+ * grazing normals the extrapolated one faced the other way, so the two-sided test left
+ * the face unlit: the teapot's rim streaks (docs/yproc.md). The colour at a centre off the
+ * face must stay within the colours the face takes on itself. */
+static void test_yp_phong_sliver_missing_the_pixel_centre(void)
+{
+    char err[256];
+    hsr_scene *sc = NULL;
+    yp_shader *sh = NULL;
+    CHECK(hsr_scene_new(&sc) == HSR_OK);
+    CHECK(hsr_scene_parse(sc, "screen 64 48\ncamera eye 0 0 10 at 0 0 0 up 0 1 0 fov 30\n"
+                          "light 0.4 0.8 0.6 1\nambient 0.2\nbackground 1 1 1\nmaterial m 0.8 0.8 0.8\n",
+                          "t.scene", NULL, err, sizeof err) == HSR_OK);
+    CHECK(hsr_obj_parse(sc, "v -1 0.06 0\nv 1 0.06 0\nv 0 0.07 0\nusemtl m\nf 1 2 3\n", "t.obj", 0,
+                        err, sizeof err) == HSR_OK);
+    CHECK(yp_shader_new(sc, YP_PHONG, &sh, err, sizeof err) == HSR_OK);
+    if (!sh) { hsr_scene_free(sc); return; }
+    /* grazing vertex normals, all facing slightly away from the eye, so flipped on the
+     * face, where every one (and so every mix of them) then faces the light; extrapolated
+     * below the base they face the eye and not the light */
+    const double vn[9] = {-0.1, -0.3, -0.05, 0.1, -0.3, -0.05, 0, 0.2, -0.4};
+    for (int i = 0; i < 9; i++) sh->vn[i] = vn[i];
+    const scene_view *vw = &sh->vw;
+    /* pixel position of a world point (the inverse of yp_shade_face's ray) */
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, base[3], spec[3];
+    double ybase = 0;
+    CHECK(sh->nl == 1);
+    for (int i = 0; i <= 20; i++)
+        for (int j = 0; i + j <= 20; j++) {
+            double w[3] = {i / 20.0, j / 20.0, (20 - i - j) / 20.0}, Q[3], d[3];
+            for (int k = 0; k < 3; k++) Q[k] = w[0] * sc->v[3 * 0 + k] + w[1] * sc->v[3 * 1 + k] + w[2] * sc->v[3 * 2 + k];
+            for (int k = 0; k < 3; k++) d[k] = Q[k] - sc->eye[k];
+            double t = -(d[0] * vw->w[0] + d[1] * vw->w[1] + d[2] * vw->w[2]);
+            double px = vw->W / 2 + vw->f * (d[0] * vw->u[0] + d[1] * vw->u[1] + d[2] * vw->u[2]) / t;
+            double py = vw->H / 2 - vw->f * (d[0] * vw->v[0] + d[1] * vw->v[1] + d[2] * vw->v[2]) / t;
+            if (w[2] == 0) ybase = py;
+            yp_shade_face(sh, 0, px, py, base, spec);
+            for (int c = 0; c < 3; c++) {
+                lo[c] = fmin(lo[c], base[c] + spec[c]);
+                hi[c] = fmax(hi[c], base[c] + spec[c]);
+            }
+        }
+    double yc = floor(ybase) + 0.5;            /* the pixel centre just below the face */
+    if (yc < ybase) yc += 1;
+    CHECK(yc - ybase < 1);
+    yp_shade_face(sh, 0, vw->W / 2 + 0.5, yc, base, spec);
+    printf("     face %.0f..%.0f, at the centre %.2f px below it %.0f\n", lo[0], hi[0], yc - ybase,
+           base[0] + spec[0]);
+    for (int c = 0; c < 3; c++) CHECK(base[c] + spec[c] >= lo[c] - 1 && base[c] + spec[c] <= hi[c] + 1);
+    yp_shader_free(sh);
+    hsr_scene_free(sc);
+}
+
 static void test_yp_no_wrap_at_full_intensity_and_black(void)
 {
     for (int white = 0; white <= 1; white++) {
@@ -475,4 +529,5 @@ void suite_yp(void)
     RUN(test_yp_de48_stream_layout);
     RUN(test_yp_anim_incremental_equals_full_rebuild);
     RUN(test_yp_no_wrap_at_full_intensity_and_black);
+    RUN(test_yp_phong_sliver_missing_the_pixel_centre);
 }
