@@ -6,8 +6,10 @@ the Verilated full-colour display_controller (3 x CHIPS chips) -> out/demo.png (
 and out/demo_8bit.png; the same streams through the golden model (must be bit-identical
 to the RTL frame); the numpy reference renderer (16x16 supersampled Phong) -> PSNR
 (target >= 38 dB). Prints the time of each stage and the Load Monitor summary, writes
-out/demo_report.json. Exit status 0 only if the RTL frame equals the golden model and
-the PSNR reaches --min-psnr.
+out/demo_report.json. Exit status 0 only if the RTL frame equals the golden model, the
+PSNR reaches --min-psnr and there are no more than --max-outliers outlier pixels (an
+error above 0.15 of full scale where the reference is smooth: isolated wrong pixels and
+streaks that an average hides; out/demo_outliers.png marks them in red).
 
 A smaller array (--chips) only makes sense with a smaller screen: the array needs at
 least ceil(width / 9) chips per colour; screens other than 640x480 run the controller's
@@ -45,6 +47,9 @@ def main(argv=None) -> int:
     ap.add_argument("--num-buf", type=int, default=1,
                     help="y-processors (buffers per colour); lines are dealt round-robin")
     ap.add_argument("--min-psnr", type=float, default=pipeline.MIN_PSNR)
+    ap.add_argument("--max-outliers", type=int, default=0,
+                    help="fail above this many outlier pixels (error > 0.15 of full scale "
+                         "where the reference is smooth; default 0)")
     a = ap.parse_args(argv)
     try:
         rep = pipeline.run(a.scene, a.out, chips=a.chips, threads=a.threads,
@@ -67,6 +72,14 @@ def main(argv=None) -> int:
           f"({'>=' if good else 'BELOW'} {a.min_psnr:g} dB target); |error| max "
           f"{rep['error']['max']}, mean {rep['error']['mean']} pixel units")
     ok &= good
+    o = rep["outliers"]
+    clean = o["count"] <= a.max_outliers
+    print(f"outliers (error > {o['error_above']:g} of full scale where the reference is "
+          f"smooth): {o['count']} ({'<=' if clean else 'ABOVE'} {a.max_outliers}); map: "
+          f"{out / o['map']}")
+    if not clean:
+        print("  first: " + ", ".join(f"({p['x']},{p['y']}) {p['error']}" for p in o["first"][:8]))
+    ok &= clean
     print(f"wrote {out / 'demo.png'} (16-bit), {out / 'demo_8bit.png'}, "
           f"{out / 'demo_reference.png'}, {out / 'demo_report.json'}")
     return 0 if ok else 1

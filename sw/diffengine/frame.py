@@ -45,6 +45,11 @@ def write_png8(path, frame12: np.ndarray, software: str = "diffengine") -> None:
     _write(path, view8(frame12), "uint8", software)
 
 
+def write_rgb8(path, img8: np.ndarray, software: str = "diffengine") -> None:
+    """An 8-bit picture as it is (diagrams, maps), no 12-bit view."""
+    _write(path, np.asarray(img8, dtype=np.uint8), "uint8", software)
+
+
 def read_png16(path) -> np.ndarray:
     """Inverse of write_png16: the 12-bit values."""
     import OpenImageIO as oiio

@@ -294,6 +294,17 @@ def run(scene, outdir, chips: int = 72, threads: int = 1, rtl: bool = True,
     err = np.abs(gold.astype(np.float64) - ref_img)
     rep["error"] = {"max": round(float(err.max()), 2), "mean": round(float(err.mean()), 4),
                     "p99": round(float(np.percentile(err, 99)), 2)}
+    # What an average hides: isolated wrong pixels and streaks on smooth surfaces.
+    bad = reference.outliers(gold, ref_img)
+    worst = err.max(axis=-1)
+    rep["outliers"] = {
+        "count": int(bad.sum()), "error_above": reference.OUTLIER_ERROR,
+        "where_reference_spans_below": reference.OUTLIER_SMOOTH,
+        "map": f"{png_name}_outliers.png",
+        "first": [{"x": int(x), "y": int(y), "error": round(float(worst[y, x]), 1)}
+                  for y, x in np.argwhere(bad)[:20]]}
+    frame.write_rgb8(outdir / f"{png_name}_outliers.png", reference.outlier_map(gold, bad),
+                     "diffengine outliers")
     rep["total_seconds"] = round(time.monotonic() - t0, 3)
     (outdir / f"{png_name}_report.json").write_text(json.dumps(rep, indent=1) + "\n")
     return rep

@@ -521,6 +521,42 @@ def psnr(frame: np.ndarray, ref: np.ndarray, peak: float = PIXEL_SCALE) -> float
     return math.inf if mse == 0 else 10 * math.log10(peak * peak / mse)
 
 
+# An outlier: a pixel that is more than OUTLIER_ERROR of full scale off the reference (in
+# its worst channel) where the reference is locally smooth (its 3x3 neighbourhood spans
+# less than OUTLIER_SMOOTH of full scale in every channel). Edges, where the box filter and
+# the reference's 16x16 samples legitimately differ by more, do not count; an isolated
+# wrong pixel or a short streak on a smooth surface does, however good the average is.
+OUTLIER_ERROR = 0.15
+OUTLIER_SMOOTH = 0.10
+
+
+def outliers(frame: np.ndarray, ref: np.ndarray, error: float = OUTLIER_ERROR,
+             smooth: float = OUTLIER_SMOOTH) -> np.ndarray:
+    """Boolean (H, W) mask of the outlier pixels of `frame` (12-bit, H x W x 3) against the
+    float reference `ref` (same shape, pixel units)."""
+    f = np.asarray(frame, dtype=np.float64)
+    r = np.asarray(ref, dtype=np.float64)
+    if f.shape != r.shape or f.ndim != 3:
+        raise ValueError(f"outliers: frame {f.shape} and reference {r.shape} must be H x W x 3")
+    err = np.abs(f - r).max(axis=-1)
+    p = np.pad(r, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    H, W = r.shape[:2]
+    win = np.stack([p[i:i + H, j:j + W] for i in range(3) for j in range(3)])
+    span = (win.max(axis=0) - win.min(axis=0)).max(axis=-1)
+    return (err > error * PIXEL_SCALE) & (span < smooth * PIXEL_SCALE)
+
+
+def outlier_map(frame: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """An 8-bit RGB picture of the outliers: the frame dimmed to grey, each outlier a red
+    3x3 square (a single pixel is hard to find in a 640x480 picture)."""
+    grey = (np.asarray(frame, dtype=np.float64).mean(axis=-1) / PIXEL_SCALE * 110 + 60)
+    img = np.repeat(grey[..., None], 3, axis=-1).astype(np.uint8)
+    H, W = mask.shape
+    for y, x in np.argwhere(mask):
+        img[max(y - 1, 0):min(y + 2, H), max(x - 1, 0):min(x + 2, W)] = (255, 0, 0)
+    return img
+
+
 def main(argv=None) -> int:
     import argparse
     import time

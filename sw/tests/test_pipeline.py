@@ -65,6 +65,8 @@ def test_pipeline_rtl_equals_golden_and_psnr(scenes, name, tmp_path):
     assert rep["mode"] == 3 and rep["screen"] == [W, H]
     assert rep["bit_identical"] is True, rep.get("first_difference")
     assert rep["psnr_db"] >= pipeline.MIN_PSNR
+    assert rep["outliers"]["count"] == 0, rep["outliers"]["first"]
+    assert (tmp_path / rep["outliers"]["map"]).is_file()
     for c in "RGB":
         assert rep["load_monitor"][c]["total_late_lines"] == 0
         assert rep["load_monitor"][c]["issued"] == sum(rep["commands_per_line"][c])
@@ -160,3 +162,21 @@ def test_demo_cli_help_mentions_chips():
                          capture_output=True, text=True)
     assert res.returncode == 0 and "smaller screen" in res.stdout.replace("\n", " ") or \
         "9*CHIPS" in res.stdout
+
+
+def test_outliers_counts_a_wrong_pixel_on_a_smooth_surface_not_at_an_edge():
+    """reference.outliers: a pixel 0.2 of full scale off where the reference is flat is
+    one; the same error on a step edge (the box filter's legitimate difference) is not."""
+    ref = np.full((8, 12, 3), 2000.0)
+    ref[:, 8:] = 500.0                              # a step edge between columns 7 and 8
+    img = np.round(ref).astype(np.uint16)
+    assert not reference.outliers(img, ref).any()
+    img[3, 3] += int(0.2 * 4095)                    # on the flat part
+    img[3, 8] += int(0.2 * 4095)                    # on the edge
+    m = reference.outliers(img, ref)
+    assert m.sum() == 1 and m[3, 3]
+    img[5, 2] += int(0.14 * 4095)                   # below the error threshold
+    assert reference.outliers(img, ref).sum() == 1
+    pic = reference.outlier_map(img, m)
+    assert pic.shape == (8, 12, 3) and pic.dtype == np.uint8
+    assert (pic[2:5, 2:5] == (255, 0, 0)).all() and (pic[6, 6] != (255, 0, 0)).any()
