@@ -101,6 +101,12 @@ def baseline_worktree() -> Path | None:
     return BASE_DIR
 
 
+def git_rev() -> str:
+    r = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+                       capture_output=True, text=True)
+    return r.stdout.strip() or "unknown"
+
+
 def timed_make(args: list[str], env: dict | None = None) -> float:
     t = time.perf_counter()
     res = subprocess.run(["make", "-s", *args], env=env or dict(os.environ),
@@ -174,13 +180,15 @@ def main(argv=None) -> int:
     jpath = Path(a.json)
     old: dict = json.loads(jpath.read_text()) if jpath.exists() else {}
     res: dict = {"verilator": verilator_version(), "machine": platform.machine(),
-                 "cpus": os.cpu_count(), "quick": a.quick, "seed": a.seed,
+                 "cpus": os.cpu_count(), "quick": a.quick, "seed": a.seed, "rev": git_rev(),
                  "date": time.strftime("%Y-%m-%d %H:%M"), "load_before": loadavg(),
                  "rounds": a.rounds,
                  "cycles_per_s": {}, "build_s": {}, "stream_s": {}, "baseline": {}}
     if a.quick:  # keep what a full run measured and this one does not
         for k in ("cycles_per_s", "build_s", "baseline"):
             res[k] = dict(old.get(k, {}))
+        res["full_run"] = old.get("full_run") if old.get("quick") else {
+            "date": old.get("date"), "rev": old.get("rev")}
         res["baseline"] = {k: dict(v) if isinstance(v, dict) else v
                            for k, v in old.get("baseline", {}).items()}
 
@@ -332,6 +340,12 @@ def write_doc(r: dict) -> None:
          fmt(bb.get("demo")), ratio(bu.get("demo"), bb.get("demo"), inverse=True)),
     ]
     table = "\n".join(f"| {a} | {n} | {o} | {x} |" for a, n, o, x in rows)
+    fr = r.get("full_run") or {}
+    quick_note = (f"This was a `QUICK=1` run (revision {r.get('rev')}): the 72-chip rates and "
+                  f"the stream times are its own; the flat, 1- and 8-chip rates and the cold "
+                  f"builds are kept from the full run of {fr.get('date') or 'an earlier date'}"
+                  f"{' (revision ' + fr['rev'] + ')' if fr.get('rev') else ''}.\n"
+                  if r.get("quick") else "")
     body = f"""{SECTION}
 
 Measured by `make bench-array` (`scripts/bench_array.py`) on {r['date']}, {r['machine']} with
@@ -341,7 +355,7 @@ RTL and harness before the fast array), built in a git worktree and run in the s
 the harnesses alternate over {r.get('rounds', 3)} rounds and each figure is the median.
 The stream is {r.get('stream_cycles', 0):,} cycles of constrained-random lines (`randgen`, 648
 columns, seed {r['seed']}); the RTL frame equals both models' frames: {r.get('stream_equal')}.
-
+{quick_note}
 | what | this revision | baseline | ratio |
 |---|---|---|---|
 {table}
