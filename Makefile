@@ -21,7 +21,7 @@ help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
 	@echo "                 controller (3 x 72 chips) and golden model -> out/demo.png, PSNR"
 	@echo "                 (SCENE=file.scene CHIPS=72 THREADS=1 RTL=0 for model only;"
-	@echo "                 first run builds the model: ~1 min on 2 cores; the RTL frame ~1 min)"
+	@echo "                 first run builds the model: ~1-1.5 min on 2 cores; the RTL frame ~35 s)"
 	@echo "make anim        the shipped animation through incremental frame deltas -> out/anim"
 	@echo "make demo-cmd    one command file through the golden model (DEMO_FILE=...)"
 	@echo "make test        run every test (sets itself up on first use)"
