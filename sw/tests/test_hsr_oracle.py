@@ -356,16 +356,35 @@ class PairRule:
         x0, y0, x1, y1 = _llround(px[0]), _llround(py[0]), _llround(px[1]), _llround(py[1])
         D = float(br - bl) + float(bt - bb) + 16
         mx, my = (px[0] + px[1]) / 2.0, (py[0] + py[1]) / 2.0
+        gz = math.hypot(pp[0] - pq[0], pp[1] - pq[1])
+
+        def splits_like(L):
+            # the line splits the extent's corners as the crossing does (corners within a
+            # unit of either line aside): near both crossing points is not enough when
+            # the planes cross only in a corner of the extent (splits_like in separate.c)
+            ln, sgn = math.hypot(L[0], L[1]), 0
+            for i in range(4):
+                de = (cx[i] * L[1] - cy[i] * L[0] - L[2]) / ln
+                if abs(de) <= 1 or abs(f[i]) <= gz:
+                    continue
+                sg = 1 if (de > 0) == (f[i] > 0) else -1
+                if sgn and sg != sgn:
+                    return False
+                sgn = sg
+            return True
+
         best, bl_ = 1.0, None
         for L in lines_p + lines_q:
             ln = math.hypot(L[0], L[1])
             d0 = abs(px[0] * L[1] - py[0] * L[0] - L[2]) / ln
             d1 = abs(px[1] * L[1] - py[1] * L[0] - L[2]) / ln
-            if max(d0, d1) < best:
+            if max(d0, d1) < best and splits_like(L):
                 best, bl_ = max(d0, d1), L
         if bl_ is None and x0 == x1 and y0 == y1:
             return
         if bl_ is None and y0 == y1:
+            if not splits_like((1, 0, -y0)):
+                return
             self.cut = ("h", y0)
             nx, ny = 0.0, 1.0
         else:
@@ -375,6 +394,8 @@ class PairRule:
                 dx, dy = dx // g, dy // g
                 if dy < 0:
                     dx, dy = -dx, -dy
+                if not splits_like((dx, dy, x0 * dy - y0 * dx)):
+                    return
                 bl_ = (dx, dy, x0 * dy - y0 * dx)
             self.cut = ("line",) + bl_
             ln = math.hypot(bl_[0], bl_[1])

@@ -19,9 +19,29 @@ static int64_t clampc(double v)
     return (int64_t)llround(v);
 }
 
+/* 1 if line L splits the corners (cx, cy) of the common extent as the crossing does (f:
+ * the depth difference there, g: its gradient's length), corners within a unit of
+ * either line aside. Being within a unit of both crossing points is not enough: when the
+ * planes cross only in a corner of the extent, the two points are a unit apart, and any
+ * line through that corner passes, also one that cuts right across the overlap. */
+static int splits_like(const line *L, const double *cx, const double *cy, const double *f, double g)
+{
+    double len = hypot((double)L->dx, (double)L->dy);
+    int sgn = 0;
+    for (int i = 0; i < 4; i++) {
+        double de = (cx[i] * (double)L->dy - cy[i] * (double)L->dx - (double)L->k) / len;
+        if (fabs(de) <= 1 || fabs(f[i]) <= g) continue;
+        int s = (de > 0) == (f[i] > 0) ? 1 : -1;
+        if (sgn && s != sgn) return 0;
+        sgn = s;
+    }
+    return 1;
+}
+
 /* canonical: p has the lower id */
 /* an input edge line within 1 unit of the crossing (a shared edge) */
-static int edge_near(const hsr_domain *d, const double *px, const double *py, double *best, line *bl)
+static int edge_near(const hsr_domain *d, const double *px, const double *py, double *best, line *bl,
+                     const double *cx, const double *cy, const double *f, double g)
 {
     int found = 0;
     for (int i = 0; d && i < d->n; i++) {
@@ -29,7 +49,7 @@ static int edge_near(const hsr_domain *d, const double *px, const double *py, do
         double len = hypot((double)L->dx, (double)L->dy);
         double d0 = fabs(px[0] * L->dy - py[0] * L->dx - (double)L->k) / len;
         double d1 = fabs(px[1] * L->dy - py[1] * L->dx - (double)L->k) / len;
-        if (fmax(d0, d1) < *best) { *best = fmax(d0, d1); *bl = *L; found = 1; }
+        if (fmax(d0, d1) < *best && splits_like(L, cx, cy, f, g)) { *best = fmax(d0, d1); *bl = *L; found = 1; }
     }
     return found;
 }
@@ -75,12 +95,20 @@ static void order_canon(const hsr_domain *dp, hsr_plane pp, hsr_extent ep, int i
     int64_t x0 = clampc(px[0]), y0 = clampc(py[0]), x1 = clampc(px[1]), y1 = clampc(py[1]);
     double D = (double)(b.right - b.left) + (double)(b.top - b.bot) + 16;
     double mx = (px[0] + px[1]) / 2.0, my = (py[0] + py[1]) / 2.0, nx, ny, best = 1.0;
-    int shared = edge_near(dp, px, py, &best, &o->cut);
-    shared |= edge_near(dq, px, py, &best, &o->cut);
+    double g = hypot(pp.a - pq.a, pp.b - pq.b);    /* |f| / g: distance to the crossing */
+    int shared = edge_near(dp, px, py, &best, &o->cut, cx, cy, f, g);
+    shared |= edge_near(dq, px, py, &best, &o->cut, cx, cy, f, g);
     if (!shared && x0 == x1 && y0 == y1) return;
-    if (!shared && y0 == y1) { o->horizontal = 1; o->hy = y0; nx = 0; ny = 1; }
+    if (!shared && y0 == y1) {
+        line h = {1, 0, -y0};                       /* y = y0 */
+        if (!splits_like(&h, cx, cy, f, g)) return;
+        o->horizontal = 1; o->hy = y0; nx = 0; ny = 1;
+    }
     else {
         if (!shared && !line_make(x0, y0, x1, y1, &o->cut)) return;
+        /* the snapped points of a crossing through a corner may be a unit apart: a cut
+         * in any direction; then the corner (under a unit square) takes the centre's order */
+        if (!shared && !splits_like(&o->cut, cx, cy, f, g)) return;
         double len = hypot((double)o->cut.dx, (double)o->cut.dy);
         nx = o->cut.dy / len; ny = -o->cut.dx / len;   /* points to the right */
     }

@@ -22,14 +22,17 @@ static void segment(double x0, double y0, double x1, double y1, double *acc, int
     for (int y = ya; y < yb; y++) {
         double *row = acc + (size_t)y * stride;
         double dy = fmin((double)(y + 1), y1) - fmax((double)y, y0);
-        double xn = x + dxdy * dy, d = dy * dir;
-        double xa = x < xn ? x : xn, xb = x < xn ? xn : x;
+        /* the row's last x: exactly x1 at the segment's end, which stepping would miss
+         * by a rounding error, below 0 if x1 = 0 (a vertex on the box's left side) */
+        double xn = y + 1 >= y1 ? x1 : x + dxdy * dy, d = dy * dir;
+        /* the box holds the domain, so x < 0 is a rounding error: take 0 (clamping only
+         * the pixel index would leave xm > 1 below and the wrong sign in cell 0) */
+        double xa = fmax(0, x < xn ? x : xn), xb = fmax(0, x < xn ? xn : x);
         double xaf = floor(xa), xbc = ceil(xb);
         int ia = (int)xaf, ib = (int)xbc;
-        if (ia < 0) ia = 0;
         if (ib > nx + 1) ib = nx + 1;
         if (ib <= ia + 1) {
-            double xm = 0.5 * (x + xn) - xaf;
+            double xm = 0.5 * (xa + xb) - xaf;
             row[ia] += d - d * xm;
             if (ia + 1 < stride) row[ia + 1] += d * xm;
         } else {

@@ -483,6 +483,40 @@ static void test_yp_phong_sliver_missing_the_pixel_centre(void)
     hsr_scene_free(sc);
 }
 
+/* A domain whose leftmost vertex lies exactly on a pixel boundary: that vertex is x = 0
+ * of the pattern's pixel box. The coverage walk steps x down an edge row by row, and at
+ * that vertex it used to land a rounding error below 0 (here -1e-16 instead of 0): the
+ * pixel index came out as -1, was clamped to 0, and the row's cell 0 took d * (1 - 1.14)
+ * instead of d * (1 - 0.14), so the pixel lost most of its coverage and the background
+ * shone through (the bunny's and the Fandisk's single bright pixels; docs/yproc.md). The
+ * triangle is one of the bunny's, moved by whole pixels; every pixel of the rectangle
+ * behind it, in the same colour, must show that colour. */
+static void test_yp_vertex_on_the_left_pixel_boundary_of_its_box(void)
+{
+    typ t;
+    CHECK(setup(&t, 16, 12, 2, NULL, YP_FLAT, 1.0));
+    set_flat(&t, 0, 2000); set_flat(&t, 1, 2000);
+    const double ox = 3, oy = 2;
+    double tri[6] = {ox + 1.71484375, oy + 0.0703125, ox + 2.42578125, oy + 3.546875, ox, oy + 3.58984375};
+    CHECK(add_poly(&t, tri, 3, 1, 1) >= 0);
+    CHECK(add_rect(&t, 1, 1, 15, 11, 2) >= 0);
+    CHECK(yp_scan(t.sh, t.h, &t.o, 0, 12, t.fr) == HSR_OK);
+    int bad = 0;
+    for (int y = 1; y < 11; y++)
+        for (int c = 0; c < 3; c++) {
+            uint16_t pix[16];
+            pixels(&t, y, c, pix);
+            for (int x = 1; x < 15; x++) {
+                double id = t.fr->ideal[((size_t)c * 12 + y) * 16 + x];
+                if (abs((int)pix[x] - 2000) > 1 || fabs(id - 2000) > 0.5) {
+                    if (!bad++) printf("     pixel (%d,%d): %d, exact target %.1f, not 2000\n", x, y, pix[x], id);
+                }
+            }
+        }
+    CHECK(bad == 0);
+    teardown(&t);
+}
+
 static void test_yp_no_wrap_at_full_intensity_and_black(void)
 {
     for (int white = 0; white <= 1; white++) {
@@ -530,4 +564,5 @@ void suite_yp(void)
     RUN(test_yp_anim_incremental_equals_full_rebuild);
     RUN(test_yp_no_wrap_at_full_intensity_and_black);
     RUN(test_yp_phong_sliver_missing_the_pixel_centre);
+    RUN(test_yp_vertex_on_the_left_pixel_boundary_of_its_box);
 }
