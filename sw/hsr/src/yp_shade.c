@@ -254,9 +254,12 @@ hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out, 
             double t = sc->ambient;
             for (int l = 0; l < sc->nlights; l++) t += sc->lights[l].rgb[c] * (m->rgb[c] + m->ks);
             if (t > 1 + 1e-9 || sc->ambient < 0 || m->rgb[c] < 0) {
+                /* the material's own line: in the scene file or in its .mtl file */
+                const char *where = m->file > 0 && m->file <= sc->nfiles ? sc->files[m->file - 1]
+                                    : sc->name[0] ? sc->name : "<scene>";
                 if (err) snprintf(err, errlen, "%s:%d: material '%s' can exceed intensity 1 in %c "
                                   "(A + sum I(kd+KS) = %.4g with %d light(s), first light on line %d); "
-                                  "lower kd, KS or the lights", sc->name[0] ? sc->name : "<scene>",
+                                  "lower kd, KS or the lights", where,
                                   m->line, m->name, "RGB"[c], t, sc->nlights, sc->lights[0].line);
                 free(used);
                 return HSR_EPARSE;
