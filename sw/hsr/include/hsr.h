@@ -196,7 +196,10 @@ typedef struct hsr_scene {
     char name[1024];                  /* scene file path (messages), "" if parsed from text */
 } hsr_scene;
 
-/* err receives "file:line: message" on failure (may be NULL). */
+/* err receives "file:line: message" on failure (may be NULL).
+ * hsr_obj_parse: name is the OBJ's path, for messages and as the directory
+ * `mtllib` files are relative to; material is the `obj` line's material
+ * (docs/hsr.md "OBJ": usemtl precedence). */
 hsr_status hsr_scene_new(hsr_scene **out);
 void hsr_scene_free(hsr_scene *sc);
 hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name,
