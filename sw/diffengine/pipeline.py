@@ -174,8 +174,8 @@ def golden(paths, width: int, height: int, carry_bug: bool = False,
 
 
 def _reference_cached(scene: Path, cache_dir: Path, samples: int = 16, progress=None):
-    """The reference frame, cached under cache_dir by the scene's (and its OBJs') text and
-    the renderer's source."""
+    """The reference frame, cached under cache_dir by the scene's (and its OBJs' and their
+    .mtl files') text and the renderer's source."""
     h = hashlib.sha256()
     h.update(Path(reference.__file__).read_bytes())
     h.update(str(samples).encode())
@@ -187,7 +187,14 @@ def _reference_cached(scene: Path, cache_dir: Path, samples: int = 16, progress=
             p = Path(tok[1])
             p = p if p.is_absolute() else scene.parent / p
             if p.exists():
-                h.update(p.read_bytes())
+                data = p.read_bytes()
+                h.update(data)
+                for ln in data.decode("utf-8", "surrogateescape").split("\n"):
+                    t = ln.split("#", 1)[0].split()
+                    for m in t[1:] if t[:1] == ["mtllib"] else ():   # its .mtl files
+                        q = p.parent / m
+                        if q.is_file():
+                            h.update(q.read_bytes())
     path = cache_dir / f".reference_{h.hexdigest()[:16]}.npy"
     if path.exists():
         return np.load(path), True

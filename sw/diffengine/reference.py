@@ -95,66 +95,291 @@ def _newell(p: np.ndarray) -> np.ndarray:
                      ((p[..., 0] - q[..., 0]) * (p[..., 1] + q[..., 1])).sum(-1)], -1)
 
 
-def _read_obj(path: Path, default_mat: int, names: dict[str, int], tris, norms, mats) -> None:
-    """Append the OBJ's triangles; smooth normals are per file (shared vertex indices)."""
+# --- OBJ and MTL, as sw/hsr/src/obj.c, mtl.c and poly.c read them (docs/hsr.md) -------
+
+_MAX_LINE = 4095          # obj.c: a line of 4096 characters or more is an error
+_MAX_ITEMS = 512          # obj.c: tokens per line
+PLANAR_TOL = 1e-6         # poly.c: a polygon is planar to 1e-6 of its bounding box diagonal
+
+
+def _read_text(path: Path, what: str, where: str) -> str:
     try:
-        text = path.read_text()
+        data = path.read_bytes()
     except OSError as e:
-        raise SceneError(f"{path}: cannot read ({e.strerror})") from None
-    verts, vns, faces = [], [], []   # faces: (vertex idx list, normal idx list|None, mat)
-    cur = default_mat
-    for lineno, line in enumerate(text.splitlines(), 1):
-        tok = _tokens(line)
-        if not tok:
+        raise SceneError(f"{where}cannot read {what} file '{path}' ({e.strerror})") from None
+    if b"\0" in data:
+        raise SceneError(f"{where}cannot read {what} file '{path}' (NUL byte)")
+    return data.decode("utf-8", errors="surrogateescape")
+
+
+def _lines(text: str, name):
+    """(line number, tokens) as obj.c's scene_tokens: split on space, tab and CR, a token
+    starting with '#' ends the line."""
+    for lineno, line in enumerate(text.split("\n"), 1):
+        if len(line) > _MAX_LINE // 4 and len(line.encode("utf-8", "surrogateescape")) > _MAX_LINE:
+            raise SceneError(f"{name}:{lineno}: line too long")   # bytes, as in C
+        tok = []
+        for t in line.replace("\t", " ").replace("\r", " ").split(" "):
+            if not t:
+                continue
+            if t[0] == "#":
+                break
+            tok.append(t)
+        if len(tok) > _MAX_ITEMS:
+            raise SceneError(f"{name}:{lineno}: too many items on one line")
+        if tok:
+            yield lineno, tok
+
+
+def _num(t: str) -> float | None:
+    """strtod + isfinite: a finite number, or None."""
+    if not t.isascii() or "_" in t:
+        return None
+    try:
+        v = float.fromhex(t) if "0x" in t.lower() else float(t)
+    except ValueError:
+        return None
+    return v if math.isfinite(v) else None
+
+
+def _int(t: str) -> int | None:
+    if not t or not t.isascii() or "_" in t or t.strip() != t:
+        return None
+    try:
+        return int(t, 10)
+    except ValueError:
+        return None
+
+
+def _triangulate(P) -> tuple[list, bool]:
+    """poly.c's poly_triangulate on points P (n, 3) as Python floats, the same arithmetic in
+    the same order: (triangles as index triples, whole), whole = convex and planar."""
+    n = len(P)
+    N = [0.0, 0.0, 0.0]
+    lo, hi, c = list(P[0]), list(P[0]), [0.0, 0.0, 0.0]
+    for a in range(n):
+        p, r = P[a], P[(a + 1) % n]
+        N[0] += (p[1] - r[1]) * (p[2] + r[2])
+        N[1] += (p[2] - r[2]) * (p[0] + r[0])
+        N[2] += (p[0] - r[0]) * (p[1] + r[1])
+        for k in range(3):
+            c[k] += p[k]
+            lo[k] = min(lo[k], p[k])
+            hi[k] = max(hi[k], p[k])
+    ax = 0
+    if abs(N[1]) > abs(N[ax]):
+        ax = 1
+    if abs(N[2]) > abs(N[ax]):
+        ax = 2
+    i, j, sign = (ax + 1) % 3, (ax + 2) % 3, (1.0 if N[ax] >= 0 else -1.0)
+
+    def cross2(a, b, cc):
+        A, B, C = P[a], P[b], P[cc]
+        return sign * ((B[i] - A[i]) * (C[j] - A[j]) - (B[j] - A[j]) * (C[i] - A[i]))
+
+    cv = all(cross2((k + n - 1) % n, k, (k + 1) % n) >= 0 for k in range(n)) and \
+        all(cross2(0, k, k + 1) >= 0 and cross2(0, 1, k + 1) >= 0 for k in range(1, n - 1))
+    ln = math.sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2])
+    diag = math.sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1])
+                     + (hi[2] - lo[2]) * (hi[2] - lo[2]))
+    dev = 0.0
+    if ln > 0:
+        for a in range(n):
+            d = 0.0
+            for k in range(3):
+                d += (P[a][k] - c[k] / n) * (N[k] / ln)
+            dev = max(dev, abs(d))
+    whole = n == 3 or (cv and ln > 0 and dev <= PLANAR_TOL * diag)
+    tris = []
+    if not cv:
+        idx = list(range(n))
+        while len(idx) > 3:
+            m, found = len(idx), -1
+            for k in range(m):
+                a, b, cc = idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]
+                if not cross2(a, b, cc) > 0:
+                    continue
+                if any(t not in (a, b, cc) and cross2(a, b, t) >= 0 and cross2(b, cc, t) >= 0
+                       and cross2(cc, a, t) >= 0 for t in idx):
+                    continue
+                found = k
+                break
+            if found < 0:
+                break           # self-intersecting or degenerate: fan the rest
+            tris.append((idx[(found + m - 1) % m], idx[found], idx[(found + 1) % m]))
+            del idx[found]
+        tris += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
+        return tris, whole
+    return [(0, k, k + 1) for k in range(1, n - 1)], whole
+
+
+def _read_mtl(path: Path, where: str, materials: list) -> dict[str, int]:
+    """mtl.c: append the .mtl file's materials; returns name -> index (last one counts)."""
+    text = _read_text(path, "MTL", where + ": ")
+    found: dict[str, int] = {}
+    cur = None
+    for lineno, tok in _lines(text, path):
+        k, at = tok[0], f"{path}:{lineno}"
+        if k == "newmtl":
+            if len(tok) != 2:
+                raise SceneError(f"{at}: 'newmtl' needs one name")
+            if len(tok[1].encode("utf-8", "surrogateescape")) >= 64:
+                raise SceneError(f"{at}: material name too long")
+            cur = Material(tok[1], (0.8, 0.8, 0.8))
+            found[tok[1]] = len(materials)
+            materials.append(cur)
             continue
-        where = f"{path}:{lineno}"
-        if tok[0] == "v":
-            verts.append(_nums(tok[1:4], 3, where))
-        elif tok[0] == "vn":
-            vns.append(_nums(tok[1:4], 3, where))
-        elif tok[0] == "f":
+        if k not in ("Kd", "Ks", "Ns", "d", "Tr"):
+            continue
+        if cur is None:
+            raise SceneError(f"{at}: '{k}' before 'newmtl'")
+        if k in ("Kd", "Ks"):
+            v = [_num(t) for t in tok[1:]]
+            if len(v) not in (1, 3) or None in v:
+                raise SceneError(f"{at}: '{k}' needs 1 or 3 finite numbers (spectral and xyz "
+                                 "are not read)")
+            rgb = (v[0],) * 3 if len(v) == 1 else tuple(v)
+            if k == "Kd":
+                cur.kd = rgb
+            else:
+                if min(rgb) < 0:
+                    raise SceneError(f"{at}: 'Ks' must be >= 0")
+                cur.ks = (rgb[0] + rgb[1] + rgb[2]) / 3
+        elif k == "Ns":
+            v = _num(tok[1]) if len(tok) == 2 else None
+            if v is None or v < 0:
+                raise SceneError(f"{at}: 'Ns' needs one finite number >= 0")
+            cur.n = max(v, 1.0)
+        else:
+            v = _num(tok[1]) if len(tok) == 2 else None
+            if v is None or not 0 <= v <= 1:
+                raise SceneError(f"{at}: '{k}' needs one number in [0,1]")
+            cur.opacity = v if k == "d" else 1 - v
+    return found
+
+
+def _read_obj(path: Path, default_mat: int, names: dict[str, int], materials: list,
+              tris, norms, mats, where: str = "") -> None:
+    """Append the OBJ's triangles, as obj.c reads the file (docs/hsr.md "OBJ") and
+    yp_shade.c gives their corners normals (docs/shading.md "Normals")."""
+    text = _read_text(path, "OBJ", where)
+    verts, vns = [], []
+    nvt = 0
+    polys = []      # (vertex idx list, normal idx list (None = none), material, group)
+    cur, group, mine = default_mat, -1, {}
+    for lineno, tok in _lines(text, path):
+        at, k = f"{path}:{lineno}", tok[0]
+        if k in ("v", "vn", "vt"):
+            if k == "v" and len(tok) not in (4, 5, 7):
+                raise SceneError(f"{at}: 'v' needs 3 coordinates (then w, or r g b)")
+            if k == "vn" and len(tok) != 4:
+                raise SceneError(f"{at}: 'vn' needs 3 numbers")
+            if k == "vt" and not 2 <= len(tok) <= 4:
+                raise SceneError(f"{at}: 'vt' needs 1 to 3 numbers")
+            x = []
+            for t in tok[1:]:
+                v = _num(t)
+                if v is None:
+                    raise SceneError(f"{at}: bad or non-finite number '{t}'")
+                x.append(v)
+            if k == "v":
+                verts.append(x[:3])
+            elif k == "vn":
+                if x == [0.0, 0.0, 0.0]:
+                    raise SceneError(f"{at}: 'vn' has zero length")
+                vns.append(x)
+            else:
+                nvt += 1
+        elif k == "f":
             if len(tok) < 4:
-                raise SceneError(f"{where}: face needs at least 3 vertices")
+                raise SceneError(f"{at}: face needs at least 3 vertices")
             vi, ni = [], []
             for t in tok[1:]:
                 parts = t.split("/")
-                try:
-                    v = int(parts[0])
-                    n = int(parts[2]) if len(parts) > 2 and parts[2] else None
-                except ValueError:
-                    raise SceneError(f"{where}: bad vertex index {t!r}") from None
-                v = v - 1 if v > 0 else len(verts) + v
-                if not 0 <= v < len(verts):
-                    raise SceneError(f"{where}: vertex index out of range")
-                if n is not None:
-                    n = n - 1 if n > 0 else len(vns) + n
-                    if not 0 <= n < len(vns):
-                        raise SceneError(f"{where}: normal index out of range")
-                vi.append(v)
-                ni.append(n)
-            faces.append((vi, ni, cur))
-        elif tok[0] == "usemtl" and len(tok) > 1:
-            cur = names.get(tok[1], default_mat)
-    if not faces:
+                bad = len(parts) > 3 or parts[0] == "" or (len(parts) == 2 and parts[1] == "")
+                raw = []
+                for q in parts:
+                    r = None if q == "" else (_int(q) if len(q) < 32 else None)
+                    bad |= q != "" and r is None
+                    raw.append(r)
+                if bad:
+                    raise SceneError(f"{at}: bad vertex index '{t}' (v, v/vt, v//vn or "
+                                     "v/vt/vn)")
+                raw += [None] * (3 - len(raw))
+                idx = []
+                for which, r, cnt in zip(("vertex", "texture", "normal"), raw,
+                                         (len(verts), nvt, len(vns))):
+                    q = None if r is None else r - 1 if r > 0 else cnt + r if r < 0 else -1
+                    if q is not None and not 0 <= q < cnt:
+                        raise SceneError(f"{at}: {which} index {r} out of range (1..{cnt})")
+                    idx.append(q)
+                vi.append(idx[0])
+                ni.append(idx[2])
+            polys.append((vi, ni, cur, group))
+        elif k == "s":
+            g = 0 if len(tok) == 2 and tok[1] == "off" else (_int(tok[1]) if len(tok) == 2
+                                                            else None)
+            if g is None or not 0 <= g <= 2147483647:
+                raise SceneError(f"{at}: 's' needs a group number >= 0 or 'off'")
+            group = g
+        elif k == "mtllib":
+            if len(tok) < 2:
+                raise SceneError(f"{at}: 'mtllib' needs a file name")
+            for t in tok[1:]:
+                mine.update(_read_mtl(Path(t) if t.startswith("/") else path.parent / t, at,
+                                      materials))
+        elif k == "usemtl":
+            # a scene-file material of that name, else this file's .mtl ones read so far,
+            # else the obj statement's material
+            if len(tok) != 2:
+                raise SceneError(f"{at}: 'usemtl' needs one name")
+            cur = names.get(tok[1], mine.get(tok[1], default_mat))
+    if not polys:
         return
     V = np.array(verts, dtype=np.float64)
     VN = np.array(vns, dtype=np.float64) if vns else np.zeros((0, 3))
-    acc = np.zeros_like(V)
-    fn = []
-    for vi, _, _ in faces:
-        n = _newell(V[vi])
-        fn.append(n)
-        np.add.at(acc, vi, n)
+    # triangles: corner vertex / normal indices, polygon, whole (convex and planar: one
+    # face in the C reader, its fan here), smoothing group, material
+    tv, tn, tp, tw, tg, tm = [], [], [], [], [], []
+    for k, (vi, ni, m, g) in enumerate(polys):
+        tri, whole = _triangulate([verts[v] for v in vi]) if len(vi) > 3 else ([(0, 1, 2)], True)
+        for t in tri:
+            tv.append([vi[c] for c in t])
+            tn.append([-1 if ni[c] is None else ni[c] for c in t])
+        tp += [k] * len(tri)
+        tw += [whole] * len(tri)
+        tg += [g] * len(tri)
+        tm += [m] * len(tri)
+    tv, tn, tp, tg = (np.array(x, dtype=np.int64) for x in (tv, tn, tp, tg))
+    tw = np.array(tw, dtype=bool)
+    tpos = V[tv]                                          # (T, 3, 3)
+    tnewell = _newell(tpos)                               # (T, 3), |.| = 2 area
+    pn = np.zeros((len(polys), 3))                        # the polygon's Newell normal
+    np.add.at(pn, tp, tnewell)
+    # the face normal: the polygon's if it is one face in the C reader, else the triangle's
+    fn = np.where(tw[:, None], pn[tp], tnewell)
+    # smooth normals per (vertex, group): each polygon of the group using the vertex once
+    cv = np.array([v for vi, _, _, _ in polys for v in vi], dtype=np.int64)
+    cg = np.array([g for vi, _, _, g in polys for _ in vi], dtype=np.int64)
+    cp = np.array([k for k, (vi, _, _, _) in enumerate(polys) for _ in vi], dtype=np.int64)
+    groups, cgi = np.unique(cg, return_inverse=True)
+    ng = len(groups)
+    vg_key = cv * ng + cgi.reshape(-1)
+    uniq = np.unique(np.stack([vg_key, cp], 1), axis=0)   # distinct (vertex+group, polygon)
+    keys, inv = np.unique(uniq[:, 0], return_inverse=True)
+    acc = np.zeros((len(keys), 3))
+    np.add.at(acc, inv.reshape(-1), pn[uniq[:, 1]])
     ln = np.linalg.norm(acc, axis=1, keepdims=True)
     smooth = np.divide(acc, ln, out=np.zeros_like(acc), where=ln > 0)
-    for (vi, ni, m), n in zip(faces, fn):
-        corner = []
-        for v, k in zip(vi, ni):
-            corner.append(VN[k] if k is not None else smooth[v])
-        for j in range(1, len(vi) - 1):          # fan, as the polygon's own plane
-            tris.append(V[[vi[0], vi[j], vi[j + 1]]])
-            norms.append(np.stack([corner[0], corner[j], corner[j + 1]]))
-            mats.append((m, n))
+    corner_key = tv * ng + np.searchsorted(groups, tg)[:, None]
+    nrm = smooth[np.searchsorted(keys, corner_key)]       # (T, 3, 3)
+    flat = tg == 0                                        # 's off': the face normal
+    nrm[flat] = fn[flat][:, None, :]
+    authored = tn >= 0                                    # `vn` overrides
+    nrm[authored] = VN[tn[authored]]
+    tris.extend(tpos)
+    norms.extend(nrm)
+    mats.extend(zip(tm, fn))
 
 
 def load_scene(path) -> Scene:
@@ -238,7 +463,8 @@ def load_scene(path) -> Scene:
             else:
                 raise SceneError(f"{where}: expected 'obj PATH [material NAME]'")
             p = Path(tok[1])
-            _read_obj(p if p.is_absolute() else path.parent / p, mat, names, tris, norms, mats)
+            _read_obj(p if p.is_absolute() else path.parent / p, mat, names, sc.materials,
+                      tris, norms, mats, where=f"{where}: ")
         elif k == "grid":
             pass
         else:

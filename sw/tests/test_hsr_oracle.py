@@ -71,6 +71,8 @@ import shapely
 from shapely.geometry import LineString, Point, Polygon, box
 from shapely.ops import polygonize, unary_union
 
+from diffengine import reference
+
 ROOT = Path(__file__).resolve().parents[2]
 HSR = ROOT / "sw" / "hsr"
 YPROC = HSR / "build" / "yproc"
@@ -180,6 +182,19 @@ def make_scene(kind: str, rng) -> tuple[list[list[tuple]], list[int], dict]:
     else:
         raise ValueError(kind)
     return faces, fm, mats
+
+
+def as_read(faces, fm):
+    """The faces as the OBJ readers store them (docs/hsr.md "OBJ", polygons): a polygon
+    that is not convex and planar (make_scene's random radii can make one concave)
+    becomes its triangles, consecutive MLR ids."""
+    out, om = [], []
+    for f, m in zip(faces, fm):
+        tris, whole = reference._triangulate([[float(x) for x in p] for p in f])
+        for t in [range(len(f))] if whole else tris:
+            out.append([f[i] for i in t])
+            om.append(m)
+    return out, om
 
 
 def write_scene(tmp: Path, faces, fm, mats) -> Path:
@@ -546,6 +561,7 @@ def test_hsr_oracle(yproc, tmp_path, kind, idx):
     rng = np.random.default_rng(seed)
     faces, fm, mats = make_scene(kind, rng)
     scene = write_scene(tmp_path, faces, fm, mats)
+    faces, fm = as_read(faces, fm)
     inp, llr = run_yproc(yproc, scene, tmp_path)
     where = f"[{kind}{idx}] seed {seed} (SEED={base} replays)"
 
@@ -699,6 +715,7 @@ def test_hsr_incremental(yproc, tmp_path, kind, idx):
     rng = np.random.default_rng(seed)
     faces, fm, mats = make_scene(kind, rng)
     scene = write_scene(tmp_path, faces, fm, mats)
+    faces, fm = as_read(faces, fm)
     ops = random_ops(rng, len(faces), int(rng.integers(8, 21)))
     opsf = tmp_path / "ops.txt"
     opsf.write_text("# test_hsr_incremental\n" + "\n".join(ops) + "\n")

@@ -74,7 +74,8 @@ int main(int argc, char **argv)
     fflush(stdout);
     static const char *dict[] = {"v ", "f ", "vn ", "usemtl ", "\n", " -", "1e308", "nan", "inf",
                                  "/", "//", "0", "-1", "2147483648", "camera ", "light ", "material ",
-                                 "obj ", "screen ", "opacity ", "#", "\xff\x7f", "\x00\x80"};
+                                 "obj ", "screen ", "opacity ", "#", "\xff\x7f", "\x00\x80",
+                                 "s ", "s off\n", "mtllib ", "vt ", "1//1 ", "1/1/1 ", "-1//-1 "};
     const size_t ndict = sizeof dict / sizeof dict[0];
     uint8_t *m = malloc((size_t)max_len + 64);
     char name[128];

@@ -157,13 +157,18 @@ hsr_status hsr_check(const hsr_ctx *h);
 
 /* ---- scenes: Wavefront OBJ + scene file (docs/hsr.md) ------------- */
 /* ks, shininess: white specular coefficient and exponent (default 0, 1);
- * flat: shade with the face normal; line: scene-file line (messages). */
+ * flat: shade with the face normal; line: line of its definition in the
+ * scene file (file == 0) or in the .mtl file sc->files[file - 1]. */
 typedef struct hsr_material {
     char name[64]; double rgb[3]; double opacity;
-    double ks, shininess; int flat, line;
+    double ks, shininess; int flat, line, file;
 } hsr_material;
-/* obj: index of the `obj` statement the face came from (0-based). */
-typedef struct hsr_face { int first, count, material, obj; } hsr_face;
+/* obj: index of the `obj` statement the face came from (0-based).
+ * smooth: OBJ smoothing group: -1 none given (the file's implicit group),
+ * 0 `s off` (shaded with the face normal), N > 0 `s N`.
+ * poly: index of the OBJ polygon; a polygon that is not convex and planar
+ * is stored as consecutive triangle faces with the same poly (docs/hsr.md). */
+typedef struct hsr_face { int first, count, material, obj, smooth, poly; } hsr_face;
 #define HSR_MAX_LIGHTS 16
 /* Directional light: dir points from the surface to the light (not
  * normalised here), rgb intensity, scene-file line. */
@@ -172,6 +177,10 @@ typedef struct hsr_light { double dir[3], rgb[3]; int line; } hsr_light;
 typedef struct hsr_scene {
     double *v; int nv, capv;          /* world x,y,z per vertex */
     int *fv; int nfv, capfv;          /* 0-based vertex indices of faces */
+    int *fvn; int capfvn;             /* per fv entry: 0-based index into vn, -1 = none */
+    double *vn; int nvn, capvn;       /* world x,y,z per OBJ `vn` (as written) */
+    int npoly;                        /* OBJ polygons read (hsr_face.poly) */
+    char **files; int nfiles, capfiles;   /* .mtl paths (hsr_material.file - 1) */
     hsr_face *f; int nf, capf;
     hsr_material *mat; int nmat, capmat;  /* mat[0] is "default" */
     int width, height, grid;
@@ -187,7 +196,10 @@ typedef struct hsr_scene {
     char name[1024];                  /* scene file path (messages), "" if parsed from text */
 } hsr_scene;
 
-/* err receives "file:line: message" on failure (may be NULL). */
+/* err receives "file:line: message" on failure (may be NULL).
+ * hsr_obj_parse: name is the OBJ's path, for messages and as the directory
+ * `mtllib` files are relative to; material is the `obj` line's material
+ * (docs/hsr.md "OBJ": usemtl precedence). */
 hsr_status hsr_scene_new(hsr_scene **out);
 void hsr_scene_free(hsr_scene *sc);
 hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name,

@@ -73,9 +73,26 @@ int scene_face_cap(const hsr_scene *sc);
 int scene_face_project(const hsr_scene *sc, const scene_view *vw, int fi, double *a, double *b,
                        int64_t *q, hsr_plane *plane);
 
-/* obj.c helpers shared with scene.c */
+/* obj.c helpers shared with scene.c and mtl.c */
 int scene_grow(void **p, int *cap, int need, size_t sz);
 int scene_tokens(char *line, char **tok, int max);
 int scene_num(const char *s, double *v);
+/* scene.c: a whole text file (NUL bytes rejected); free() *text */
+hsr_status scene_read_file(const char *path, char **text);
+
+/* mtl.c: read the .mtl file at path and append its materials (newmtl, Kd,
+ * Ks, Ns, d, Tr) to sc->mat with file = its index in sc->files + 1.
+ * Errors: "path:line: message"; a file that cannot be read is reported as
+ * "where: cannot read MTL file 'path' (...)" (where: the OBJ's file:line). */
+hsr_status scene_mtl_load(hsr_scene *sc, const char *path, const char *where,
+                          char *err, size_t errlen);
+
+/* poly.c: triangulation of an OBJ polygon p (3 doubles per point, n >= 3):
+ * fan (0, i, i+1) if it is convex in the plane of its Newell normal, else
+ * ear clipping (docs/hsr.md gives the exact rule, shared with the reference
+ * renderer).  tri receives 3 * (n - 2) indices into p; returns the number
+ * of triangles (n - 2).  *whole = 1 if the polygon is convex and planar to
+ * 1e-6 of its size, so that one face with that fan is the same surface. */
+int poly_triangulate(const double *p, int n, int *tri, int *whole);
 
 #endif

@@ -19,7 +19,7 @@ hsr_status hsr_scene_new(hsr_scene **out)
     hsr_light dl = {{1, 1, 1}, {0.8, 0.8, 0.8}, 0};
     sc->lights[0] = dl; sc->nlights = 1;
     if (!scene_grow((void **)&sc->mat, &sc->capmat, 1, sizeof(hsr_material))) { free(sc); return HSR_ENOMEM; }
-    hsr_material d = {"default", {0.8, 0.8, 0.8}, 1.0, 0.0, 1.0, 0, 0};
+    hsr_material d = {"default", {0.8, 0.8, 0.8}, 1.0, 0.0, 1.0, 0, 0, 0};
     sc->mat[0] = d; sc->nmat = 1;
     *out = sc;
     return HSR_OK;
@@ -28,10 +28,12 @@ hsr_status hsr_scene_new(hsr_scene **out)
 void hsr_scene_free(hsr_scene *sc)
 {
     if (!sc) return;
-    free(sc->v); free(sc->fv); free(sc->f); free(sc->mat); free(sc);
+    for (int i = 0; i < sc->nfiles; i++) free(sc->files[i]);
+    free(sc->files);
+    free(sc->v); free(sc->fv); free(sc->fvn); free(sc->vn); free(sc->f); free(sc->mat); free(sc);
 }
 
-static hsr_status read_file(const char *path, char **text)
+hsr_status scene_read_file(const char *path, char **text)
 {
     *text = NULL;
     FILE *f = fopen(path, "rb");
@@ -153,7 +155,7 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             hsr_material *m = &sc->mat[sc->nmat++];
             snprintf(m->name, sizeof m->name, "%s", tok[1]);
             m->rgb[0] = v[0]; m->rgb[1] = v[1]; m->rgb[2] = v[2]; m->opacity = op;
-            m->ks = ks; m->shininess = shin; m->flat = flat; m->line = lineno;
+            m->ks = ks; m->shininess = shin; m->flat = flat; m->line = lineno; m->file = 0;
         } else if (!strcmp(k, "obj")) {
             if (nt != 2 && !(nt == 4 && !strcmp(tok[2], "material"))) FAIL(HSR_EPARSE, "expected 'obj PATH [material NAME]'");
             int mat = 0;
@@ -166,7 +168,7 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             if (tok[1][0] == '/' || !dir) snprintf(path, sizeof path, "%s", tok[1]);
             else snprintf(path, sizeof path, "%s/%s", dir, tok[1]);
             char *text2;
-            hsr_status st = read_file(path, &text2);
+            hsr_status st = scene_read_file(path, &text2);
             if (st != HSR_OK) FAIL(st, "cannot read OBJ file '%s' (%s)", path, hsr_status_str(st));
             int nf0 = sc->nf;
             st = hsr_obj_parse(sc, text2, path, mat, err, errlen);
@@ -185,7 +187,7 @@ hsr_status hsr_scene_load(const char *path, hsr_scene **out, char *err, size_t e
     if (!path || !out) return HSR_EINVAL;
     *out = NULL;
     char *text;
-    hsr_status st = read_file(path, &text);
+    hsr_status st = scene_read_file(path, &text);
     if (st != HSR_OK) {
         if (err) snprintf(err, errlen, "%s: cannot read (%s)", path, hsr_status_str(st));
         return st;

@@ -6,11 +6,17 @@
 #define YP_PIX 4095.0                 /* intensity 1.0 in pixel units */
 #define YP_ONE ((double)(1 << 24))    /* 1 pixel unit in 12.24 */
 
+struct yp_corner { int v, g, poly, face, c; };
+
 struct yp_shader {
     const hsr_scene *sc;
     yp_shading mode;
     scene_view vw;
-    double *vn;          /* 3 per vertex: smooth normal (unit) */
+    double *cn;          /* 3 per face corner (sc->fv entry): its normal (unit): the
+                          * authored `vn`, else the face normal (`s off`), else the
+                          * smooth normal of its vertex in its smoothing group */
+    struct yp_corner *ck;   /* the corners sorted by (vertex, group, polygon) */
+    double *pn;          /* 3 per face: Newell normal of its OBJ polygon (unnormalised) */
     double *fn;          /* 3 per face: unit face normal (Newell), 0 if degenerate */
     double *flat;        /* 3 per face: flat colour, pixel units (flat mode) */
     double *gour;        /* 15 per face: I = a x + b y + c per colour, then min, max (gouraud) */

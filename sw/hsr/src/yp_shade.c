@@ -1,5 +1,5 @@
-/* yp_shade.c - the shading model of docs/shading.md: smooth vertex
- * normals, directional lights, Phong illumination (eq. 6.1.a with the
+/* yp_shade.c - the shading model of docs/shading.md: corner normals
+ * (authored `vn`, smoothing groups, smooth vertex normals), directional lights, Phong illumination (eq. 6.1.a with the
  * surface coefficients of Foley 90), two-sided, local viewer; and the
  * flat / Gouraud colour functions.  Values are in pixel units (4095 = 1). */
 #include <math.h>
@@ -105,9 +105,9 @@ static void face_point_normal(const yp_shader *s, int fi, double *P, double *N)
         const double *a = vtx(sc, fi, 0), *b = vtx(sc, fi, bi), *c = vtx(sc, fi, bi + 1);
         for (int k = 0; k < 3; k++) P[k] = bw[0] * a[k] + bw[1] * b[k] + bw[2] * c[k];
     }
-    const int *fv = &sc->fv[F->first];
+    const double *cn = &s->cn[3 * (size_t)F->first];
     for (int k = 0; k < 3; k++)
-        N[k] = bw[0] * s->vn[3 * fv[0] + k] + bw[1] * s->vn[3 * fv[bi] + k] + bw[2] * s->vn[3 * fv[bi + 1] + k];
+        N[k] = bw[0] * cn[k] + bw[1] * cn[3 * bi + k] + bw[2] * cn[3 * (bi + 1) + k];
 }
 
 static void centroid(const hsr_scene *sc, int fi, double *P)
@@ -167,7 +167,7 @@ static void face_functions(yp_shader *s, int fi)
         if (!(ze < -1e-9)) return;           /* behind the eye: keep flat */
         xs[i] = vw->W / 2 + vw->f * dot3(d, vw->u) / -ze;
         ys[i] = vw->H / 2 - vw->f * dot3(d, vw->v) / -ze;
-        const double *N = m->flat ? &s->fn[3 * fi] : &s->vn[3 * sc->fv[sc->f[fi].first + i]];
+        const double *N = m->flat ? &s->fn[3 * fi] : &s->cn[3 * (size_t)(sc->f[fi].first + i)];
         phong(s, m, V, N, I[i], NULL, 0);
     }
     double det = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (xs[2] - xs[0]) * (ys[1] - ys[0]);
@@ -182,6 +182,15 @@ static void face_functions(yp_shader *s, int fi)
     }
 }
 
+static int corner_cmp(const void *pa, const void *pb)
+{
+    const struct yp_corner *a = pa, *b = pb;
+    if (a->v != b->v) return a->v < b->v ? -1 : 1;
+    if (a->g != b->g) return a->g < b->g ? -1 : 1;
+    if (a->poly != b->poly) return a->poly < b->poly ? -1 : 1;
+    return (a->c > b->c) - (a->c < b->c);
+}
+
 hsr_status yp_shader_update(yp_shader *s, const hsr_scene *sc)
 {
     s->sc = sc;
@@ -193,16 +202,38 @@ hsr_status yp_shader_update(yp_shader *s, const hsr_scene *sc)
         memcpy(s->Lrgb[l], sc->lights[l].rgb, sizeof s->Lrgb[l]);
     }
     for (int c = 0; c < 3; c++) s->bg[c] = sc->bg[c] * YP_PIX;
-    memset(s->vn, 0, sizeof(double) * 3 * (size_t)(sc->nv + 1));
     for (int fi = 0; fi < sc->nf; fi++) {
         double n[3];
         newell(sc, fi, n);
-        for (int i = 0; i < sc->f[fi].count; i++)
-            for (int k = 0; k < 3; k++) s->vn[3 * sc->fv[sc->f[fi].first + i] + k] += n[k];
+        memcpy(&s->pn[3 * fi], n, sizeof n);
         if (!unit3(n)) n[0] = n[1] = n[2] = 0;
         memcpy(&s->fn[3 * fi], n, sizeof n);
     }
-    for (int v = 0; v < sc->nv; v++) unit3(&s->vn[3 * v]);
+    /* a polygon stored as triangles: their Newell normals add up to the polygon's */
+    for (int a = 0, b; a < sc->nf; a = b) {
+        double n[3] = {0, 0, 0};
+        for (b = a; b < sc->nf && sc->f[b].poly == sc->f[a].poly; b++)
+            for (int k = 0; k < 3; k++) n[k] += s->pn[3 * b + k];
+        for (int i = a; i < b; i++) memcpy(&s->pn[3 * i], n, sizeof n);
+    }
+    /* smooth normals: per vertex and smoothing group, the sum of the Newell normals of
+     * the polygons of that group that use the vertex (each polygon once) */
+    for (int a = 0, b; a < sc->nfv; a = b) {
+        const struct yp_corner *A = &s->ck[a];
+        double n[3] = {0, 0, 0};
+        for (b = a; b < sc->nfv && s->ck[b].v == A->v && s->ck[b].g == A->g; b++)
+            if (b == a || s->ck[b].poly != s->ck[b - 1].poly)
+                for (int k = 0; k < 3; k++) n[k] += s->pn[3 * s->ck[b].face + k];
+        unit3(n);
+        for (int i = a; i < b; i++) memcpy(&s->cn[3 * (size_t)s->ck[i].c], n, sizeof n);
+    }
+    for (int fi = 0; fi < sc->nf; fi++)
+        for (int i = 0; i < sc->f[fi].count; i++) {
+            int c = sc->f[fi].first + i, k = sc->fvn ? sc->fvn[c] : -1;
+            double *N = &s->cn[3 * (size_t)c];
+            if (k >= 0) { memcpy(N, &sc->vn[3 * k], 3 * sizeof(double)); unit3(N); }   /* authored */
+            else if (sc->f[fi].smooth == 0) memcpy(N, &s->fn[3 * fi], 3 * sizeof(double));   /* s off */
+        }
     for (int fi = 0; fi < sc->nf; fi++) face_functions(s, fi);
     return HSR_OK;
 }
@@ -223,9 +254,12 @@ hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out, 
             double t = sc->ambient;
             for (int l = 0; l < sc->nlights; l++) t += sc->lights[l].rgb[c] * (m->rgb[c] + m->ks);
             if (t > 1 + 1e-9 || sc->ambient < 0 || m->rgb[c] < 0) {
+                /* the material's own line: in the scene file or in its .mtl file */
+                const char *where = m->file > 0 && m->file <= sc->nfiles ? sc->files[m->file - 1]
+                                    : sc->name[0] ? sc->name : "<scene>";
                 if (err) snprintf(err, errlen, "%s:%d: material '%s' can exceed intensity 1 in %c "
                                   "(A + sum I(kd+KS) = %.4g with %d light(s), first light on line %d); "
-                                  "lower kd, KS or the lights", sc->name[0] ? sc->name : "<scene>",
+                                  "lower kd, KS or the lights", where,
                                   m->line, m->name, "RGB"[c], t, sc->nlights, sc->lights[0].line);
                 free(used);
                 return HSR_EPARSE;
@@ -241,11 +275,20 @@ hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out, 
     yp_shader *s = calloc(1, sizeof *s);
     if (!s) return HSR_ENOMEM;
     s->mode = mode;
-    s->vn = malloc(sizeof(double) * 3 * (size_t)(sc->nv + 1));
+    s->cn = malloc(sizeof(double) * 3 * (size_t)(sc->nfv + 1));
+    s->ck = malloc(sizeof(struct yp_corner) * (size_t)(sc->nfv + 1));
+    s->pn = malloc(sizeof(double) * 3 * (size_t)(sc->nf + 1));
     s->fn = malloc(sizeof(double) * 3 * (size_t)(sc->nf + 1));
     s->flat = malloc(sizeof(double) * 3 * (size_t)(sc->nf + 1));
     s->gour = malloc(sizeof(double) * 15 * (size_t)(sc->nf + 1));
-    if (!s->vn || !s->fn || !s->flat || !s->gour) { yp_shader_free(s); return HSR_ENOMEM; }
+    if (!s->cn || !s->ck || !s->pn || !s->fn || !s->flat || !s->gour) { yp_shader_free(s); return HSR_ENOMEM; }
+    for (int fi = 0; fi < sc->nf; fi++)     /* the corner order depends on the topology only */
+        for (int i = 0; i < sc->f[fi].count; i++) {
+            int c = sc->f[fi].first + i;
+            struct yp_corner k = {sc->fv[c], sc->f[fi].smooth, sc->f[fi].poly, fi, c};
+            s->ck[c] = k;
+        }
+    qsort(s->ck, (size_t)sc->nfv, sizeof *s->ck, corner_cmp);
     hsr_status st = yp_shader_update(s, sc);
     if (st == HSR_OK && sc->bg_image[0]) st = read_ppm(sc->bg_image, sc->width, sc->height, &s->img, err, errlen);
     if (st != HSR_OK) { yp_shader_free(s); return st; }
@@ -292,5 +335,5 @@ void yp_shader_free(yp_shader *s)
 {
     if (!s) return;
     free(s->img);
-    free(s->vn); free(s->fn); free(s->flat); free(s->gour); free(s);
+    free(s->cn); free(s->ck); free(s->pn); free(s->fn); free(s->flat); free(s->gour); free(s);
 }

@@ -27,6 +27,7 @@ void suite_grid(void);
 void suite_hsr(void);
 void suite_props(void);
 void suite_io(void);
+void suite_obj(void);
 void suite_yp(void);
 int fuzz_run(int iterations, unsigned long long seed);
 

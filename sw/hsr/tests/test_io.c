@@ -6,7 +6,7 @@
 
 static const char *CUBE =
     "# unit cube\nv -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
-    "usemtl red\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2/1 3/1 7/1 6/1\nf 3//1 4//1 8//1 7//1\nf -8 -4 -1 -5\n";
+    "vt 0 0\nvn 0 1 0\nusemtl red\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2/1 3/1 7/1 6/1\nf 3//1 4//1 8//1 7//1\nf -8 -4 -1 -5\n";
 
 static hsr_scene *cube_scene(const char *extra)
 {

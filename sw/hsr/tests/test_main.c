@@ -65,6 +65,7 @@ int main(int argc, char **argv)
     suite_hsr();
     suite_props();
     suite_io();
+    suite_obj();
     suite_yp();
     printf("%d passed, %d failed\n", n_pass, n_fail);
     return n_fail != 0;
