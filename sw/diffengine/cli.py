@@ -1,4 +1,4 @@
-"""`diffengine` command line: asm, disasm, model, plot, capacity (see docs/formats.md).
+"""`diffengine` command line: asm, disasm, model, plot, capacity, compare (see docs/formats.md).
 
 User errors (bad input files, bad options) print `file:where: message` on stderr and exit
 non-zero without a traceback; a traceback means a bug in the tools.
@@ -324,6 +324,22 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--dpi", type=int, default=110)
     s.set_defaults(func=cmd_plot)
 
+    s = sub.add_parser("compare", help="a frame against a reference: PSNR, maximum error, "
+                       "outlier pixels and their map (the quality gate of make demo)")
+    s.add_argument("frame", help="16-bit PNG/TIFF of 12-bit pixels (diffengine model, "
+                   "make demo's demo.png) or .npy")
+    s.add_argument("reference", help="a .scene file (rendered by the 16x16 reference "
+                   "renderer), or a 16-bit image / .npy of the reference")
+    s.add_argument("--map", help="write the outlier map here (PNG; outliers in red on the "
+                   "frame's grey)")
+    s.add_argument("--max-outliers", type=int, default=0,
+                   help="exit 3 when there are more outlier pixels than this (default 0)")
+    s.add_argument("--min-psnr", type=float, default=None,
+                   help="exit 3 when the PSNR is below this (dB)")
+    s.add_argument("--samples", type=int, default=16,
+                   help="reference sub-samples per pixel side for a .scene (default 16)")
+    s.set_defaults(func=cmd_compare)
+
     s = sub.add_parser("capacity", help="print the capacity model report (Table 7.3)")
     s.set_defaults(func=cmd_capacity)
     # Listed for --help only; main() hands `encode` to diffengine.encode.encode_main.
@@ -336,6 +352,59 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser("inspect", help="one frame as a self-contained HTML page: image, scanline "
                    "graph, per-pixel commands and register history (diffengine inspect -h)")
     return p
+
+
+EXIT_GATE = 3   # compare: the frame fails the quality gate
+
+
+def _image(path: str, samples: int):
+    import numpy as np
+
+    from . import frame, reference
+    if path.endswith(".npy"):
+        return np.load(path).astype(np.float64)
+    if path.endswith(".scene"):
+        try:
+            return reference.render_file(path, samples)
+        except reference.SceneError as e:
+            raise CliError(str(e)) from None
+    if not Path(path).is_file():
+        raise CliError(f"{path}: no such file")
+    try:
+        return frame.read_png16(path).astype(np.float64)
+    except OSError as e:
+        raise CliError(str(e)) from None
+
+
+def cmd_compare(a) -> int:
+    """PSNR, maximum error and outliers (reference.outliers) of a frame against a
+    reference; the same numbers as make demo's report."""
+    import numpy as np
+
+    from . import frame, reference
+    img = _image(a.frame, a.samples)
+    ref = _image(a.reference, a.samples)
+    if img.shape != ref.shape:
+        raise CliError(f"{a.frame} is {img.shape[1]}x{img.shape[0]} but {a.reference} is "
+                       f"{ref.shape[1]}x{ref.shape[0]}")
+    err = np.abs(img - ref)
+    bad = reference.outliers(img, ref)
+    n = int(bad.sum())
+    psnr = reference.psnr(img, ref)
+    print(f"PSNR {psnr:.2f} dB; |error| max {err.max():.1f}, mean {err.mean():.4f} pixel units")
+    print(f"outliers (error > {reference.OUTLIER_ERROR} of full scale where the reference "
+          f"varies by < {reference.OUTLIER_SMOOTH}): {n}")
+    worst = err.max(axis=-1) if err.ndim == 3 else err
+    for y, x in np.argwhere(bad)[:10]:
+        print(f"  x={x} y={y}: error {worst[y, x]:.0f}")
+    if n > 10:
+        print(f"  ... and {n - 10} more")
+    if a.map:
+        shown = np.clip(np.round(img), 0, 4095).astype(np.uint16)
+        frame.write_rgb8(a.map, reference.outlier_map(shown, bad), "diffengine compare")
+        print(f"outlier map: {a.map}")
+    fail = n > a.max_outliers or (a.min_psnr is not None and psnr < a.min_psnr)
+    return EXIT_GATE if fail else 0
 
 
 def main(argv=None) -> int:

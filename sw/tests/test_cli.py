@@ -218,3 +218,31 @@ def test_encode_subcommand_is_wired(tmp_path):
     from diffengine import cli
     out = tmp_path / "r.cmd"
     assert cli.main(["encode", "/no/such/image.png", "-o", str(out)]) != 0
+
+
+def test_compare_reports_outliers_and_fails_the_gate(tmp_path, capsys):
+    """diffengine compare: a smooth ramp against itself passes; one pixel 0.25 of full
+    scale off on the flat part is an outlier (exit 3, map written); a step edge that is
+    off by as much is not (the reference is not smooth there)."""
+    from diffengine import frame
+    ref = np.zeros((12, 16, 3), dtype=np.uint16)
+    ref[:] = (np.arange(16) * 8 + 1000)[None, :, None]
+    ref[:, 12:] = 3000                                   # an edge at column 12
+    frame.write_png16(tmp_path / "ref.png", ref)
+    frame.write_png16(tmp_path / "same.png", ref)
+    rc, out, _ = run(capsys, "compare", tmp_path / "same.png", tmp_path / "ref.png")
+    assert rc == 0 and "outliers" in out and ": 0" in out
+    bad = ref.copy()
+    bad[5, 4] += 1024                                    # flat neighbourhood
+    bad[5, 12] -= 1024                                   # on the edge: not counted
+    frame.write_png16(tmp_path / "bad.png", bad)
+    m = tmp_path / "map.png"
+    rc, out, _ = run(capsys, "compare", tmp_path / "bad.png", tmp_path / "ref.png", "--map", m)
+    assert rc == cli.EXIT_GATE
+    assert "x=4 y=5" in out and "x=12" not in out and m.is_file()
+    assert "max 1024.0" in out
+    rc, _, _ = run(capsys, "compare", tmp_path / "bad.png", tmp_path / "ref.png",
+                   "--max-outliers", "1")
+    assert rc == 0
+    rc, _, err = run(capsys, "compare", tmp_path / "bad.png", tmp_path / "nope.png")
+    assert rc == cli.EXIT_INPUT and "nope.png" in err
