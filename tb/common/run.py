@@ -3,6 +3,7 @@ of the current directory, seeds printed so a random run can be replayed."""
 from __future__ import annotations
 
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -20,12 +21,19 @@ def build_and_test(tb_dir: Path, toplevel: str, sources: list[Path], test_module
     tag = "_".join(f"{k}{v}" for k, v in sorted(parameters.items())) or "default"
     build_dir = tb_dir / f"sim_build_{tag}"
     runner = get_runner("verilator")
+    # ccache, when installed, compiles the Verilated C++ (sim/Makefile does the same);
+    # CCACHE_BASEDIR makes its hashes independent of where the checkout is, so a fresh
+    # clone on a machine that built the same RTL before compiles nothing again.
+    cache = shutil.which("ccache")
+    if cache:
+        os.environ.setdefault("CCACHE_BASEDIR", str(REPO))
     runner.build(
         sources=[str(s) for s in sources],
         hdl_toplevel=toplevel,
         parameters=parameters,
         build_dir=build_dir,
         build_args=["-Wno-fatal", "-MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include"]
+        + (["-MAKEFLAGS", f"OBJCACHE={cache}"] if cache else [])
         + (["--trace-fst", "--trace-structs"] if waves else []),
         waves=waves,
     )
