@@ -84,7 +84,7 @@ test: $(SETUP)
 
 test-py: $(SETUP)
 	@./scripts/ensure_system.sh
-	$(ENV) cd sw && $(PY) -m pytest -q -n 2 tests
+	$(ENV) cd sw && $(PY) -m pytest -q -n 2 --dist worksteal tests
 
 test-c:
 	@./scripts/ensure_system.sh
@@ -95,9 +95,11 @@ test-c:
 fuzz-hsr:
 	$(MAKE) -C sw/hsr/fuzz long
 
+# --dist worksteal: an idle worker takes queued tests from the busy one (the long
+# benches otherwise leave one core idle at the end).
 test-rtl: $(SETUP)
 	@./scripts/ensure_system.sh
-	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 --durations=12 .; fi
+	@if ls tb/*/test_*.py >/dev/null 2>&1; then $(ENV) cd tb && $(PY) -m pytest -q -n 2 --dist worksteal --durations=12 .; fi
 
 # The RTL regression (docs/regression.md): TIER=smoke|full|nightly, J parallel jobs.
 TIER ?= full
