@@ -102,6 +102,11 @@ typedef int (*sweep_classify)(uint64_t dom_bits, uint64_t cut_bits, void *ctx);
 hsr_status sweep_overlay(const sweep_in *in, int nin, const int64_t *hcut_y,
                          const int *hcut_bit, int nhcut, sweep_classify fn,
                          void *ctx, int nlabels, hsr_domain **out);
+/* the same, but if keep != NULL and *keep == 0 once the sweep is done (the
+ * classifier sets it), nothing is assembled: out[] are all NULL */
+hsr_status sweep_overlay_if(const sweep_in *in, int nin, const int64_t *hcut_y,
+                            const int *hcut_bit, int nhcut, sweep_classify fn,
+                            void *ctx, int nlabels, hsr_domain **out, const int *keep);
 
 /* separate.c: depth order of surface p vs q, with the optional cut line */
 typedef struct pair_order {
