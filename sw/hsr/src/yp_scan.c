@@ -322,9 +322,20 @@ static hsr_status finish_line(scan *s, int y, int c)
     qsort(ord, (size_t)n, sizeof(entry *), ent_area_cmp);
     /* section 7.5: lower the colour function of the least visible
      * patterns first, Eval3 -> Eval2 for all, then Eval2 -> Eval1 */
-    for (int lev = 3; lev >= 2 && line_cost(L->e, n, NULL, bgl.slots) > s->o->capacity; lev--)
-        for (int i = 0; i < n && line_cost(L->e, n, NULL, bgl.slots) > s->o->capacity; i++)
-            if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) ord[i]->lev = lev - 1;
+    /* the line's cost (line_cost) is kept up to date as patterns are lowered,
+     * not recounted per pattern: O(n) instead of O(n^2) on a busy line */
+    int sum = bgl.slots, nsp = 0;
+    for (int i = 0; i < n; i++) {
+        sum += L->e[i]->cost[L->e[i]->lev];
+        nsp += L->e[i]->lev == 3 && L->e[i]->spec_cost;
+    }
+    for (int lev = 3; lev >= 2 && sum + (nsp > 0) > s->o->capacity; lev--)
+        for (int i = 0; i < n && sum + (nsp > 0) > s->o->capacity; i++)
+            if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) {
+                sum -= ord[i]->cost[lev] - ord[i]->cost[lev - 1];
+                if (lev == 3 && ord[i]->spec_cost) nsp--;
+                ord[i]->lev = lev - 1;
+            }
     free(ord);
     int cost = line_cost(L->e, n, &sp, bgl.slots);
     ls->degraded[c] = 0;
