@@ -232,6 +232,8 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         int s = cand.v[ci];
         llr *N = &h->l[s];
         if (!N->used || !hsr_extent_overlap(rem->ext, N->dom->ext)) continue;
+        /* interiors shown disjoint: the overlay would meet nothing (saw_both 0) */
+        if (dom_interiors_apart(rem, N->dom)) continue;
         add_ctx c;
         memset(&c, 0, sizeof c);
         c.h = h; c.id = id; c.k = N->nvis; c.pre = N->par.v;

@@ -89,6 +89,7 @@ static inline int64_t x_ceil(const line *a, ry y) { return (int64_t)-floordiv128
 hsr_domain *dom_new(void);
 int dom_push(hsr_domain *d, const edge *e);
 void dom_finish_extent(hsr_domain *d);
+int dom_interiors_apart(const hsr_domain *a, const hsr_domain *b);   /* 1: shown disjoint */
 
 /* sweep.c - overlay of up to 64 sources (even-odd each) and 64 cut lines.
  * classify(dom_bits, cut_bits, ctx) -> label in [0,nlabels) or -1.
