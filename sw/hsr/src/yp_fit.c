@@ -93,10 +93,16 @@ int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n,
     if (n <= 0 || order < 0 || order > 2) return -1;
     const double S = YP_ONE, T = tol * S * (1 - 1e-9);
     (void)S;
-    int *kp = malloc(sizeof(int) * (size_t)(n + 1));
-    int64_t *kc = malloc(sizeof(int64_t) * (size_t)(n + 1));
-    int64_t *val = malloc(sizeof(int64_t) * (size_t)n);
-    if (!kp || !kc || !val) { free(kp); free(kc); free(val); return -1; }
+    /* short spans (most: a mesh makes ~10^6 fits of a few pixels) use the
+     * stack, not three mallocs */
+    enum { NSMALL = 256 };
+    int kp_s[NSMALL + 1];
+    int64_t kc_s[NSMALL + 1], val_s[NSMALL];
+    int small = n <= NSMALL;
+    int *kp = small ? kp_s : malloc(sizeof(int) * (size_t)(n + 1));
+    int64_t *kc = small ? kc_s : malloc(sizeof(int64_t) * (size_t)(n + 1));
+    int64_t *val = small ? val_s : malloc(sizeof(int64_t) * (size_t)n);
+    if (!kp || !kc || !val) { if (!small) { free(kp); free(kc); free(val); } return -1; }
     /* start: exact at the first pixel, slope to the next constrained one */
     int j = 1;
     while (j < n && !use[j]) j++;
@@ -165,6 +171,6 @@ int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n,
     }
     yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {v0[0], v0[1], v0[2]}};
     if (st == HSR_OK) st = yp_cmdlist_push(out, ev);
-    free(kp); free(kc); free(val);
+    if (!small) { free(kp); free(kc); free(val); }
     return bad || st != HSR_OK ? -1 : nk;
 }
