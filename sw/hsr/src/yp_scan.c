@@ -19,10 +19,8 @@
  *   - pixels it covers partly: Eval1 (x, 1, cov * (colour - background)).
  * Specular terms of Phong patterns come last, after Acc_mode (1): they
  * are >= 0, so a fitted quadratic that dips below 0 contributes 0. */
-#define _DEFAULT_SOURCE
 #include <math.h>
 #include <stddef.h>
-#include <sys/mman.h>
 #include <stdlib.h>
 #include <string.h>
 #include "yp_internal.h"
@@ -64,14 +62,9 @@ static void *arena_alloc(arena *a, size_t sz)
     sz = (sz + sizeof(max_align_t) - 1) / sizeof(max_align_t) * sizeof(max_align_t);
     arena_blk *b = a->head;
     if (!b || b->cap - b->used < sz) {
-        const size_t HP = (size_t)1 << 21, BLK = (size_t)8 << 20;
-        size_t cap = sz > BLK ? sz : BLK, tot = (sizeof(arena_blk) + cap + HP - 1) / HP * HP;
-        b = aligned_alloc(HP, tot);
+        size_t cap = sz > ((size_t)1 << 20) ? sz : ((size_t)1 << 20);
+        b = malloc(sizeof(arena_blk) + cap);
         if (!b) return NULL;
-#ifdef MADV_HUGEPAGE
-        madvise(b, tot, MADV_HUGEPAGE);   /* fewer page faults (a hint; no effect on results) */
-#endif
-        cap = tot - sizeof(arena_blk);
         b->next = a->head; b->used = 0; b->cap = cap;
         a->head = b;
     }
