@@ -29,6 +29,7 @@ static struct scratch {
     int *lab; size_t caplab;                /* lastpiece, start, fill: 3 * (nlabels + 1) */
     int *idx; size_t capidx;                /* assemble: idx, indeg, adj_head, adj_next, adj_to, queue */
     edge *ed; size_t caped;
+    int64_t *K; size_t capK;                /* integer slab boundaries */
 } S;
 
 static int grow(void **p, size_t *cap, size_t need, size_t sz)
@@ -75,6 +76,23 @@ static int grow(void **p, size_t *cap, size_t need, size_t sz)
 #define SEDGE_LE(a, b) (ry_cmp((a)->e->y0, (b)->e->y0) <= 0)
 DEFINE_STABLE_SORT(sort_ry, ry, RY_LE)
 DEFINE_STABLE_SORT(sort_sedge, sedge, SEDGE_LE)
+#define I64_LE(a, b) (*(a) <= *(b))
+DEFINE_STABLE_SORT(sort_i64, int64_t, I64_LE)
+
+/* The slab boundaries: usually all integers (q = 1; then equal values are
+ * equal (p, q) too, so sorting the 64-bit numerators gives the very array
+ * the general sort gives), else the stable sort on exact comparisons. */
+static int sort_ys(ry *a, size_t n)
+{
+    if (!GROW(S.K, S.capK, n + 1)) return 0;
+    for (size_t i = 0; i < n; i++) {
+        if (a[i].q != 1 || a[i].p < INT64_MIN || a[i].p > INT64_MAX) return sort_ry(a, n);
+        S.K[i] = (int64_t)a[i].p;
+    }
+    if (!sort_i64(S.K, n)) return 0;
+    for (size_t i = 0; i < n; i++) a[i].p = S.K[i];
+    return 1;
+}
 
 static const piece *g_pieces; /* sort context (single-threaded use) */
 static int cmp_piece(const piece *p, const piece *q)
@@ -191,7 +209,7 @@ hsr_status sweep_overlay_if(const sweep_in *in, int nin, const int64_t *hcut_y,
                 || ry_cmp(y, es[j].e->y1) >= 0) continue;
             PUSH(S.Y, S.nY, S.capY, y);
         }
-    if (!sort_ry(S.Y, S.nY)) goto fail;
+    if (!sort_ys(S.Y, S.nY)) goto fail;
     ry *ys = S.Y;
     int ny = 0;
     for (size_t i = 0; i < S.nY; i++) if (ny == 0 || ry_cmp(ys[ny - 1], ys[i]) != 0) ys[ny++] = ys[i];
