@@ -9,16 +9,29 @@
 * a plot of slots per line against capacity: docs/img/yproc_slots_per_line.png.
 
     python3 scripts/bench_yproc.py [--write] [--quick]
+    python3 scripts/bench_yproc.py --scaling [--baseline-rev REV] [--repeat 5] [--write]
 
 --quick skips the no-aa / gouraud / flat variants. Progress goes to stderr.
+
+--scaling (issue 21, large meshes): `yproc scan` time against the triangle count, from
+about 1K to 100K triangles at 640x480: teapots made by sw/scenes/teapot/make_teapot.py
+(-n 4, 7, 13, 22, 40: 992 .. 102,080 triangles, same camera) and the Stanford bunny
+(sw/scenes/meshes/bunny.scene, 69,451).  With --baseline-rev, the yproc of that revision
+(sources taken with `git archive`, built in a temporary directory) runs alternately with
+this tree's in the same session; every figure is the min and median of --repeat runs,
+wall clock and the child's CPU time (user + sys), with the load average before and after.
+--write replaces the table between the `scaling` markers in docs/performance.md.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
+import statistics
 import subprocess
 import sys
+import tarfile
 import tempfile
 import time
 from pathlib import Path
@@ -43,6 +56,9 @@ RUNS = [  # scene, label, extra args
     ("sw/scenes/cad/cad_sky.scene", "cad_sky", []),
 ]
 ANIM = "sw/scenes/anim/cad_drag.anim"
+SCALING_TEAPOTS = [4, 7, 13, 22, 40]          # make_teapot.py -n: 992 .. 102,080 triangles
+SCALING_MESH = "sw/scenes/meshes/bunny.scene"  # 69,451 triangles
+SCALING_BEGIN, SCALING_END = "<!-- scaling:begin -->", "<!-- scaling:end -->"
 
 
 def log(msg: str) -> None:
@@ -97,13 +113,119 @@ def plot(rows: list, path: Path) -> None:
     plt.close(fig)
 
 
+def build_rev(rev: str, tmp: Path) -> Path:
+    """yproc of git revision rev, built from `git archive` in tmp (the repository is not touched)."""
+    src = tmp / "base"
+    src.mkdir()
+    arch = tmp / "base.tar"
+    with open(arch, "wb") as f:
+        subprocess.run(["git", "-C", str(ROOT), "archive", rev, "sw/hsr"], stdout=f, check=True)
+    with tarfile.open(arch) as t:
+        t.extractall(src)
+    subprocess.run(["make", "-s", "-C", str(src / "sw" / "hsr"), "build/yproc"], check=True)
+    return src / "sw" / "hsr" / "build" / "yproc"
+
+
+def timed_scan(yproc: Path, scene: Path, out: Path) -> tuple:
+    """(wall s, CPU s of the child, stats.json) of one `yproc scan`"""
+    r0, t0 = os.times(), time.perf_counter()
+    res = subprocess.run([str(yproc), "scan", str(scene), "-o", str(out)], capture_output=True, text=True)
+    wall, r1 = time.perf_counter() - t0, os.times()
+    if res.returncode:
+        sys.exit(f"bench_yproc: {yproc} scan {scene} failed:\n{res.stderr}")
+    cpu = (r1.children_user - r0.children_user) + (r1.children_system - r0.children_system)
+    return wall, cpu, json.loads((out / "stats.json").read_text())
+
+
+def loadavg() -> str:
+    try:
+        return Path("/proc/loadavg").read_text().split()[0]
+    except OSError:
+        return "?"
+
+
+def scaling(a) -> int:
+    rev = None
+    if a.baseline_rev:
+        rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", a.baseline_rev],
+                             capture_output=True, text=True, check=True).stdout.strip()
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+                          capture_output=True, text=True).stdout.strip()
+    with tempfile.TemporaryDirectory() as tmpd:
+        tmp = Path(tmpd)
+        bins = [("this tree", YPROC)]
+        if rev:
+            log(f"building the baseline yproc of {rev}")
+            bins.append((f"baseline {rev}", build_rev(rev, tmp)))
+        scenes = []
+        for n in SCALING_TEAPOTS:
+            d = tmp / f"teapot{n}"
+            subprocess.run([sys.executable, str(ROOT / "sw/scenes/teapot/make_teapot.py"), "-n", str(n),
+                            "-o", str(d)], check=True, capture_output=True)
+            scenes.append((f"teapot -n {n}", d / "teapot.scene"))
+        scenes.append(("bunny", ROOT / SCALING_MESH))
+        load0 = loadavg()
+        res = {}   # (scene, binary) -> list of (wall, cpu, stats)
+        t_start = time.time()
+        for name, scene in scenes:
+            for k in range(a.repeat):
+                for bname, b in bins:   # alternate: baseline and this tree in turn
+                    res.setdefault((name, bname), []).append(timed_scan(b, scene, tmp / "out"))
+            r = res[(name, bins[0][0])]
+            log(f"[scaling] {name}: {r[0][2]['faces']} triangles, " + ", ".join(
+                f"{bn} {min(x[0] for x in res[(name, bn)]):.2f} s" for bn, _ in bins))
+        load1 = loadavg()
+    L = [f"Reproduce: `python3 scripts/bench_yproc.py --scaling"
+         f"{' --baseline-rev ' + a.baseline_rev if a.baseline_rev else ''} --repeat {a.repeat}` "
+         f"(started {time.strftime('%Y-%m-%d %H:%M', time.localtime(t_start))}, revision {head}"
+         f"{', baseline ' + rev if rev else ''}; {time.time() - t_start:.0f} s; 1-min load average "
+         f"{load0} before, {load1} after, on the shared 2-core machine). Each `yproc scan` "
+         f"(load, HSR, scan conversion, write) ran {a.repeat} times, "
+         f"{'the two binaries alternately, ' if rev else ''}640x480, Phong, AA; "
+         "wall = min / median wall clock, CPU = min user + sys of the process, "
+         "HSR and scan = min of yproc's own CPU-time stages; us/tri = min wall / triangles.", "",
+         "| scene | triangles | visible domains | binary | wall s (min / median) | CPU s | HSR s | scan s | us / tri |",
+         "|---|---|---|---|---|---|---|---|---|"]
+    for name, _ in scenes:
+        for bname, _ in bins:
+            r = res[(name, bname)]
+            st = r[0][2]
+            w = [x[0] for x in r]
+            L.append(f"| {name} | {st['faces']:,} | {st['llr_domains']:,} | {bname} | {min(w):.2f} / "
+                     f"{statistics.median(w):.2f} | {min(x[1] for x in r):.2f} | "
+                     f"{min(x[2]['times_ms']['hsr'] for x in r) / 1e3:.2f} | "
+                     f"{min(x[2]['times_ms']['scan'] for x in r) / 1e3:.2f} | {1e6 * min(w) / st['faces']:.1f} |")
+    if rev:
+        L += ["", "| scene | triangles | speed-up, min wall | speed-up, min CPU |", "|---|---|---|---|"]
+        for name, _ in scenes:
+            b, c = res[(name, bins[1][0])], res[(name, bins[0][0])]
+            L.append(f"| {name} | {c[0][2]['faces']:,} | {min(x[0] for x in b) / min(x[0] for x in c):.1f}x | "
+                     f"{min(x[1] for x in b) / min(x[1] for x in c):.1f}x |")
+    text = "\n".join(L)
+    print(text)
+    if a.write:
+        path = ROOT / "docs" / "performance.md"
+        doc = path.read_text()
+        if SCALING_BEGIN not in doc or SCALING_END not in doc:
+            sys.exit(f"bench_yproc: no {SCALING_BEGIN} ... {SCALING_END} markers in {path}")
+        i, j = doc.index(SCALING_BEGIN) + len(SCALING_BEGIN), doc.index(SCALING_END)
+        path.write_text(doc[:i] + "\n" + text + "\n" + doc[j:])
+        log(f"updated {path}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--write", action="store_true", help="update docs/performance.md and the plot")
     ap.add_argument("--quick", action="store_true", help="default shading with AA only")
+    ap.add_argument("--scaling", action="store_true", help="yproc scan time against triangle count (1K..100K)")
+    ap.add_argument("--baseline-rev", help="with --scaling: also time the yproc of this git revision")
+    ap.add_argument("--repeat", type=int, default=5, help="with --scaling: runs per scene and binary")
     a = ap.parse_args(argv)
     if subprocess.run(["make", "-s", "-C", str(ROOT / "sw" / "hsr"), "build/yproc"]).returncode:
         return 1
+    if a.scaling:
+        return scaling(a)
     runs = [r for r in RUNS if not (a.quick and r[2])]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

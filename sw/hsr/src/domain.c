@@ -27,6 +27,63 @@ int hsr_extent_overlap(hsr_extent a, hsr_extent b)
 
 hsr_domain *dom_new(void) { return calloc(1, sizeof(hsr_domain)); }
 
+/* sign of x dy - y dx - k of line L at the point of edge line e at height y
+ * (> 0: right of L).  x = xnum / (e.dy q), so the sign is that of
+ * xnum(e, y) L.dy - (p L.dx + k q) e.dy: below 2^123 (docs/hsr.md bounds). */
+static int side_of(const line *L, const line *e, ry y)
+{
+    if (y.q == 1 && y.p >= -((i128)1 << 31) && y.p < ((i128)1 << 31)) {
+        int64_t yp = (int64_t)y.p;   /* |k + dx y| < 2^48 + 2^55: int64 */
+        i128 v = (i128)(e->k + e->dx * yp) * L->dy - (i128)(L->k + L->dx * yp) * e->dy;
+        return sgn128(v);
+    }
+    return sgn128(xnum(e, y) * L->dy - ((i128)L->dx * y.p + (i128)L->k * y.q) * e->dy);
+}
+
+/* 1 if every edge end of d lies on side s of L or on L (s * side_of <= 0 fails) */
+static int all_on_side(const hsr_domain *d, const line *L, int s)
+{
+    for (int i = 0; i < d->n; i++) {
+        const edge *e = &d->e[i];
+        if (s * side_of(L, &e->ln, e->y0) < 0 || s * side_of(L, &e->ln, e->y1) < 0) return 0;
+    }
+    return 1;
+}
+
+/* 1 if the edge lines of x hold a line with x on one closed side and y on
+ * the other */
+static int split_by_edge_of(const hsr_domain *x, const hsr_domain *y)
+{
+    for (int i = 0; i < x->n; i++) {
+        const edge *e = &x->e[i];
+        /* side +1: x's interior is to the right of e */
+        if (all_on_side(y, &e->ln, -e->side) && all_on_side(x, &e->ln, e->side)) return 1;
+    }
+    return 0;
+}
+
+/* Cheap exact test that the interiors of a and b are disjoint (then an
+ * overlay of the two has no part covered by both): a horizontal line or
+ * an edge line of either with one domain on each closed side.  0 means
+ * "not shown", not "they overlap".  Small domains only (the test is
+ * quadratic in the edges). */
+int dom_interiors_apart(const hsr_domain *a, const hsr_domain *b)
+{
+    if (!a || !b || !a->n || !b->n) return 1;
+    if (a->n + b->n > 24) return 0;
+    ry alo = a->e[0].y0, ahi = a->e[0].y1, blo = b->e[0].y0, bhi = b->e[0].y1;
+    for (int i = 1; i < a->n; i++) {
+        if (ry_cmp(a->e[i].y0, alo) < 0) alo = a->e[i].y0;
+        if (ry_cmp(a->e[i].y1, ahi) > 0) ahi = a->e[i].y1;
+    }
+    for (int i = 1; i < b->n; i++) {
+        if (ry_cmp(b->e[i].y0, blo) < 0) blo = b->e[i].y0;
+        if (ry_cmp(b->e[i].y1, bhi) > 0) bhi = b->e[i].y1;
+    }
+    if (ry_cmp(ahi, blo) <= 0 || ry_cmp(bhi, alo) <= 0) return 1;
+    return split_by_edge_of(a, b) || split_by_edge_of(b, a);
+}
+
 int dom_push(hsr_domain *d, const edge *e)
 {
     if (d->n == d->cap) {

@@ -232,6 +232,8 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         int s = cand.v[ci];
         llr *N = &h->l[s];
         if (!N->used || !hsr_extent_overlap(rem->ext, N->dom->ext)) continue;
+        /* interiors shown disjoint: the overlay would meet nothing (saw_both 0) */
+        if (dom_interiors_apart(rem, N->dom)) continue;
         add_ctx c;
         memset(&c, 0, sizeof c);
         c.h = h; c.id = id; c.k = N->nvis; c.pre = N->par.v;
@@ -252,7 +254,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         }
         int nlab = c.k + 3;
         hsr_domain *res[HSR_MAX_PREFIX + 3];
-        st = sweep_overlay(in, nin, hy, hb, nh, classify_add, &c, nlab, res);
+        st = sweep_overlay_if(in, nin, hy, hb, nh, classify_add, &c, nlab, res, &c.saw_both);
         if (st != HSR_OK) goto done;
         if (!c.saw_both) { for (int i = 0; i < nlab; i++) hsr_domain_free(res[i]); continue; }
         hsr_domain_free(rem);

@@ -25,24 +25,71 @@ struct hsr_domain {
 
 /* exact.c */
 int line_make(int64_t x0, int64_t y0, int64_t x1, int64_t y1, line *out);
-int line_eq(const line *a, const line *b);
-int line_cmp(const line *a, const line *b);      /* total order */
-ry ry_int(int64_t v);
-int ry_cmp(ry a, ry b);
 int line_cross_y(const line *a, const line *b, ry *y); /* 0 if parallel */
-int x_cmp_at(const line *a, const line *b, ry y);   /* sign(xa(y)-xb(y)) */
 int x_cmp_int(const line *a, ry y, int64_t x);      /* sign(xa(y)-x) */
 double ry_d(ry y);
 double x_at_d(const line *a, ry y);
-int64_t ry_floor(ry y);
-int64_t ry_ceil(ry y);
-int64_t x_floor(const line *a, ry y);
-int64_t x_ceil(const line *a, ry y);
+
+/* The hot predicates are inline (they are most of the overlay's time).
+ * Each fast path is exact: it is taken only where it gives the same
+ * integer result as the general 128-bit expression. */
+static inline int sgn128(i128 v) { return (v > 0) - (v < 0); }
+
+static inline int line_eq(const line *a, const line *b)
+{
+    return a->dx == b->dx && a->dy == b->dy && a->k == b->k;
+}
+
+static inline int line_cmp(const line *a, const line *b)   /* total order */
+{
+    if (a->dx != b->dx) return a->dx < b->dx ? -1 : 1;
+    if (a->dy != b->dy) return a->dy < b->dy ? -1 : 1;
+    if (a->k != b->k) return a->k < b->k ? -1 : 1;
+    return 0;
+}
+
+static inline ry ry_int(int64_t v) { ry r; r.p = v; r.q = 1; return r; }
+
+/* sign(a - b); equal denominators (q > 0): compare the numerators */
+static inline int ry_cmp(ry a, ry b)
+{
+    if (a.q == b.q) return (a.p > b.p) - (a.p < b.p);
+    return sgn128(a.p * b.q - b.p * a.q);
+}
+
+/* numerator of x(y) = (k q + dx p) / (dy q) */
+static inline i128 xnum(const line *a, ry y) { return (i128)a->k * y.q + (i128)a->dx * y.p; }
+
+/* sign(xa(y) - xb(y)); equal dy (> 0): compare the numerators */
+static inline int x_cmp_at(const line *a, const line *b, ry y)
+{
+    if (a->dy == b->dy) return sgn128(xnum(a, y) - xnum(b, y));
+    return sgn128(xnum(a, y) * b->dy - xnum(b, y) * a->dy);
+}
+
+/* floor(n / d), d > 0; 64-bit division where both fit (same result) */
+static inline i128 floordiv128(i128 n, i128 d)
+{
+    if (n >= INT64_MIN && n <= INT64_MAX && d <= INT64_MAX) {
+        int64_t n6 = (int64_t)n, d6 = (int64_t)d, q = n6 / d6;
+        if (n6 % d6 != 0 && n6 < 0) q -= 1;
+        return q;
+    }
+    i128 q = n / d;
+    if ((n % d) != 0 && n < 0) q -= 1;
+    return q;
+}
+
+static inline int64_t ry_floor(ry y) { return (int64_t)floordiv128(y.p, y.q); }
+static inline int64_t ry_ceil(ry y) { return (int64_t)-floordiv128(-y.p, y.q); }
+static inline int64_t x_floor(const line *a, ry y) { return (int64_t)floordiv128(xnum(a, y), (i128)a->dy * y.q); }
+static inline int64_t x_ceil(const line *a, ry y) { return (int64_t)-floordiv128(-xnum(a, y), (i128)a->dy * y.q); }
 
 /* domain.c */
 hsr_domain *dom_new(void);
 int dom_push(hsr_domain *d, const edge *e);
 void dom_finish_extent(hsr_domain *d);
+int dom_interiors_apart(const hsr_domain *a, const hsr_domain *b);   /* 1: shown disjoint */
 
 /* sweep.c - overlay of up to 64 sources (even-odd each) and 64 cut lines.
  * classify(dom_bits, cut_bits, ctx) -> label in [0,nlabels) or -1.
@@ -56,6 +103,11 @@ typedef int (*sweep_classify)(uint64_t dom_bits, uint64_t cut_bits, void *ctx);
 hsr_status sweep_overlay(const sweep_in *in, int nin, const int64_t *hcut_y,
                          const int *hcut_bit, int nhcut, sweep_classify fn,
                          void *ctx, int nlabels, hsr_domain **out);
+/* the same, but if keep != NULL and *keep == 0 once the sweep is done (the
+ * classifier sets it), nothing is assembled: out[] are all NULL */
+hsr_status sweep_overlay_if(const sweep_in *in, int nin, const int64_t *hcut_y,
+                            const int *hcut_bit, int nhcut, sweep_classify fn,
+                            void *ctx, int nlabels, hsr_domain **out, const int *keep);
 
 /* separate.c: depth order of surface p vs q, with the optional cut line */
 typedef struct pair_order {

@@ -69,17 +69,34 @@ static int segment(const double *f, const unsigned char *use, const double *tolv
     return e;
 }
 
-/* 1 if highest difference c from segment start k (lower differences v)
- * keeps every constrained pixel k .. p within tol */
+/* The terms of a segment's values at offset t, v[r] * binom(t, r) and
+ * binom(t, order), for t < filled: check() is called for every candidate
+ * end p and would otherwise recompute them for every pixel before p.
+ * The same products in the same order, so the same doubles. */
+typedef struct segtab { double *B, *w0, *w1; int filled; } segtab;
+
+static void tab_fill(segtab *tb, int upto, int order, const int64_t *v)
+{
+    for (int t = tb->filled; t <= upto; t++) {
+        tb->B[t] = binom(t, order);
+        tb->w0[t] = (double)v[0] * binom(t, 0);
+        tb->w1[t] = order > 1 ? (double)v[1] * binom(t, 1) : 0;
+    }
+    if (upto + 1 > tb->filled) tb->filled = upto + 1;
+}
+
+/* 1 if highest difference c from segment start k (lower differences v,
+ * terms in tb up to p - k) keeps every constrained pixel k .. p within tol */
 static int check(const double *f, const unsigned char *use, const double *tolv, int order, double T, double tol, int clamp,
-                 int k, const int64_t *v, double c, int p)
+                 int k, const segtab *tb, double c, int p)
 {
     const double S = YP_ONE;
     for (int t = order; k + t <= p; t++) {
         int x = k + t;
         if (!use[x]) continue;
-        double val = c * binom(t, order);
-        for (int r = 0; r < order; r++) val += (double)v[r] * binom(t, r);
+        double val = c * tb->B[t];
+        val += tb->w0[t];
+        if (order > 1) val += tb->w1[t];
         double tgt = f[x] * S, Tx = tolv ? tolv[x] * S * (1 - 1e-9) : T;
         if (clamp && f[x] <= tol) { if (val > tgt + Tx || val < -2000.0 * S) return 0; }
         else if (fabs(val - tgt) > Tx) return 0;
@@ -93,10 +110,19 @@ int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n,
     if (n <= 0 || order < 0 || order > 2) return -1;
     const double S = YP_ONE, T = tol * S * (1 - 1e-9);
     (void)S;
-    int *kp = malloc(sizeof(int) * (size_t)(n + 1));
-    int64_t *kc = malloc(sizeof(int64_t) * (size_t)(n + 1));
-    int64_t *val = malloc(sizeof(int64_t) * (size_t)n);
-    if (!kp || !kc || !val) { free(kp); free(kc); free(val); return -1; }
+    /* short spans (most: a mesh makes ~10^6 fits of a few pixels) use the
+     * stack, not three mallocs */
+    enum { NSMALL = 256 };
+    int kp_s[NSMALL + 1];
+    int64_t kc_s[NSMALL + 1], val_s[NSMALL];
+    double tab_s[3 * (NSMALL + 1)];
+    int small = n <= NSMALL;
+    int *kp = small ? kp_s : malloc(sizeof(int) * (size_t)(n + 1));
+    int64_t *kc = small ? kc_s : malloc(sizeof(int64_t) * (size_t)(n + 1));
+    int64_t *val = small ? val_s : malloc(sizeof(int64_t) * (size_t)n);
+    double *tab = small ? tab_s : malloc(sizeof(double) * 3 * (size_t)(n + 1));
+    if (!kp || !kc || !val || !tab) { if (!small) { free(kp); free(kc); free(val); free(tab); } return -1; }
+    segtab tb = {tab, tab + n + 1, tab + 2 * (n + 1), 0};
     /* start: exact at the first pixel, slope to the next constrained one */
     int j = 1;
     while (j < n && !use[j]) j++;
@@ -122,14 +148,17 @@ int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n,
              * first failure */
             int bestp = -1, fails = 0;
             double bestc = 0;
+            tb.filled = 0;   /* new segment start: new terms */
             for (int p = k + order; p < n && fails < 6; p++) {
                 if (!use[p]) continue;
                 int t = p - k;
+                tab_fill(&tb, t, order, v);
                 double base = 0;
-                for (int r = 0; r < order; r++) base += (double)v[r] * binom(t, r);
+                base += tb.w0[t];
+                if (order > 1) base += tb.w1[t];
                 double tgt = (clamp && f[p] <= tol) ? fmin(f[p] * S, 0) : f[p] * S;
-                double cc = round((tgt - base) / binom(t, order));
-                if (check(f, use, tolv, order, T, tol, clamp, k, v, cc, p)) { bestp = p; bestc = cc; fails = 0; }
+                double cc = round((tgt - base) / tb.B[t]);
+                if (check(f, use, tolv, order, T, tol, clamp, k, &tb, cc, p)) { bestp = p; bestc = cc; fails = 0; }
                 else fails++;
             }
             if (bestp < 0) {     /* cannot happen: p = k + order is exact up to rounding */
@@ -165,6 +194,6 @@ int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n,
     }
     yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {v0[0], v0[1], v0[2]}};
     if (st == HSR_OK) st = yp_cmdlist_push(out, ev);
-    free(kp); free(kc); free(val);
+    if (!small) { free(kp); free(kc); free(val); free(tab); }
     return bad || st != HSR_OK ? -1 : nk;
 }

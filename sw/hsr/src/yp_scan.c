@@ -20,6 +20,7 @@
  * Specular terms of Phong patterns come last, after Acc_mode (1): they
  * are >= 0, so a fitted quadratic that dips below 0 contributes 0. */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "yp_internal.h"
@@ -50,12 +51,41 @@ static int key_cmp(const void *pa, const void *pb)
     return a->slot < b->slot ? -1 : a->slot > b->slot;
 }
 
-static void entry_free(entry *e)
+/* Entries and their command lists live in an arena freed at the end of the
+ * frame: a 70K-triangle mesh makes ~400K entries, and one malloc per list
+ * (with room for 16 commands) cost most of the scan's time and ~600 MB. */
+typedef struct arena_blk { struct arena_blk *next; size_t used, cap; max_align_t data[]; } arena_blk;
+typedef struct arena { arena_blk *head; } arena;
+
+static void *arena_alloc(arena *a, size_t sz)
 {
-    if (!e) return;
-    yp_cmdlist_free(&e->spec);
-    for (int i = 0; i < 4; i++) yp_cmdlist_free(&e->lv[i]);
-    free(e);
+    sz = (sz + sizeof(max_align_t) - 1) / sizeof(max_align_t) * sizeof(max_align_t);
+    arena_blk *b = a->head;
+    if (!b || b->cap - b->used < sz) {
+        size_t cap = sz > ((size_t)1 << 20) ? sz : ((size_t)1 << 20);
+        b = malloc(sizeof(arena_blk) + cap);
+        if (!b) return NULL;
+        b->next = a->head; b->used = 0; b->cap = cap;
+        a->head = b;
+    }
+    void *p = (char *)b->data + b->used;
+    b->used += sz;
+    return p;
+}
+
+static void arena_free(arena *a)
+{
+    while (a->head) { arena_blk *n = a->head->next; free(a->head); a->head = n; }
+}
+
+/* a copy of scratch list src in the arena (src stays for reuse) */
+static hsr_status arena_list(arena *a, const yp_cmdlist *src, yp_cmdlist *dst)
+{
+    dst->c = NULL; dst->n = dst->cap = src->n; dst->slots = src->slots;
+    if (!src->n) return HSR_OK;
+    if (!(dst->c = arena_alloc(a, sizeof(yp_cmd) * (size_t)src->n))) return HSR_ENOMEM;
+    memcpy(dst->c, src->c, sizeof(yp_cmd) * (size_t)src->n);
+    return HSR_OK;
 }
 
 typedef struct scan {
@@ -69,6 +99,8 @@ typedef struct scan {
     unsigned char *use, *use2;
     double *tmp, *tolv;
     double *covsum;            /* [y1 - y0][W]: coverage of all patterns */
+    arena ar;                  /* entries and their lists */
+    yp_cmdlist wl[4], wspec;   /* scratch lists of one entry */
 } scan;
 
 /* Dis over the runs of [a, b) where in[x - off] == 0 */
@@ -138,16 +170,19 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
     unsigned char *cv = s->use2 + s->W;         /* covered, relative to a */
     for (int x = a; x <= cl; x++) cv[x - a] = cov[x - x0] > 0;
     for (int c = 0; c < 3; c++) {
-        entry *e = calloc(1, sizeof *e);
+        entry *e = arena_alloc(&s->ar, sizeof *e);
         if (!e) return HSR_ENOMEM;
+        memset(e, 0, sizeof *e);
         line_entries *L = &le[c];
         if (L->n == L->cap) {
             int nc = L->cap ? 2 * L->cap : 32;
             entry **p = realloc(L->e, sizeof(entry *) * (size_t)nc);
-            if (!p) { free(e); return HSR_ENOMEM; }
+            if (!p) return HSR_ENOMEM;
             L->e = p; L->cap = nc;
         }
         L->e[L->n++] = e;
+        for (int i = 0; i < 4; i++) s->wl[i].n = s->wl[i].slots = 0;
+        s->wspec.n = s->wspec.slots = 0;
         e->area = area; e->npart = npart;
         e->maxlev = o->shading == YP_FLAT ? 1 : o->shading == YP_GOURAUD ? 2 : 3;
         /* separate specular terms (level 3): lights whose highlight on the
@@ -178,8 +213,9 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
              * pixel shared by several patterns add up to its box average */
             double *tv = s->tolv;
             for (int x = a; x <= cl; x++) tv[x - a] = cov[x - x0] < 1 ? fmin(tol, TOL_PARTIAL) : tol;
-            st = push_dis(&e->lv[lev], cv, a, a + n, a);
-            if (st == HSR_OK && yp_fit(f, cv, tv, n, a, lev - 1, tol, 0, &e->lv[lev]) < 0) st = HSR_ELIMIT;
+            st = push_dis(&s->wl[lev], cv, a, a + n, a);
+            if (st == HSR_OK && yp_fit(f, cv, tv, n, a, lev - 1, tol, 0, &s->wl[lev]) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK) st = arena_list(&s->ar, &s->wl[lev], &e->lv[lev]);
             e->cost[lev] = e->lv[lev].slots;
         }
         for (int l = 0; l < nl && st == HSR_OK && nsep; l++) {
@@ -189,9 +225,10 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             for (int x = a; x <= cl; x++)
                 if (full[x] && s->fs[3 * nl * x + 3 * l + c] > o->tol) { if (sa < 0) sa = x; sb = x; }
             for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
-            st = push_dis(&e->spec, use, sa, sb + 1, sa);
-            if (st == HSR_OK && yp_fit(f, use, NULL, sb + 1 - sa, sa, 2, o->tol, 1, &e->spec) < 0) st = HSR_ELIMIT;
+            st = push_dis(&s->wspec, use, sa, sb + 1, sa);
+            if (st == HSR_OK && yp_fit(f, use, NULL, sb + 1 - sa, sa, 2, o->tol, 1, &s->wspec) < 0) st = HSR_ELIMIT;
         }
+        if (st == HSR_OK) st = arena_list(&s->ar, &s->wspec, &e->spec);
         if (st != HSR_OK) return st;
         e->spec_cost = e->spec.slots;
         if (e->maxlev == 3) e->cost[3] += e->spec.slots;
@@ -285,9 +322,20 @@ static hsr_status finish_line(scan *s, int y, int c)
     qsort(ord, (size_t)n, sizeof(entry *), ent_area_cmp);
     /* section 7.5: lower the colour function of the least visible
      * patterns first, Eval3 -> Eval2 for all, then Eval2 -> Eval1 */
-    for (int lev = 3; lev >= 2 && line_cost(L->e, n, NULL, bgl.slots) > s->o->capacity; lev--)
-        for (int i = 0; i < n && line_cost(L->e, n, NULL, bgl.slots) > s->o->capacity; i++)
-            if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) ord[i]->lev = lev - 1;
+    /* the line's cost (line_cost) is kept up to date as patterns are lowered,
+     * not recounted per pattern: O(n) instead of O(n^2) on a busy line */
+    int sum = bgl.slots, nsp = 0;
+    for (int i = 0; i < n; i++) {
+        sum += L->e[i]->cost[L->e[i]->lev];
+        nsp += L->e[i]->lev == 3 && L->e[i]->spec_cost;
+    }
+    for (int lev = 3; lev >= 2 && sum + (nsp > 0) > s->o->capacity; lev--)
+        for (int i = 0; i < n && sum + (nsp > 0) > s->o->capacity; i++)
+            if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) {
+                sum -= ord[i]->cost[lev] - ord[i]->cost[lev - 1];
+                if (lev == 3 && ord[i]->spec_cost) nsp--;
+                ord[i]->lev = lev - 1;
+            }
     free(ord);
     int cost = line_cost(L->e, n, &sp, bgl.slots);
     ls->degraded[c] = 0;
@@ -364,7 +412,9 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     if (y0 < 0) y0 = 0;
     if (y1 > fr->height) y1 = fr->height;
     if (y0 >= y1) return HSR_OK;
-    scan s = {sh, o, fr, fr->width, fr->height, y0, y1, sh->nl, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+    scan s;
+    memset(&s, 0, sizeof s);
+    s.sh = sh; s.o = o; s.fr = fr; s.W = fr->width; s.H = fr->height; s.y0 = y0; s.y1 = y1; s.nl = sh->nl;
     const int W = s.W;
     const double U = HSR_SUBPIXEL;
     hsr_status st = HSR_OK;
@@ -464,10 +514,12 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
 done:
     if (s.le) {
         for (int i = 0; i < 3 * (y1 - y0); i++) {
-            for (int k = 0; k < s.le[i].n; k++) entry_free(s.le[i].e[k]);
             free(s.le[i].e);
         }
     }
+    arena_free(&s.ar);
+    for (int i = 0; i < 4; i++) yp_cmdlist_free(&s.wl[i]);
+    yp_cmdlist_free(&s.wspec);
     free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
     return st;
 }
