@@ -24,6 +24,7 @@ from pathlib import Path
 import pytest
 
 from diffengine import pipeline
+from scene_files import scene_copy
 
 REPO = Path(__file__).resolve().parents[2]
 MESHES = REPO / "sw" / "scenes" / "meshes"
@@ -43,20 +44,8 @@ SHIPPED = {
 
 def _resized(src: Path, tmp: Path, scale: int) -> Path:
     """The scene with its screen divided by `scale` and its file paths made absolute."""
-    out = []
-    for line in src.read_text().splitlines():
-        tok = line.split()
-        if tok[:1] == ["screen"] and scale != 1:
-            line = f"screen {int(tok[1]) // scale} {int(tok[2]) // scale}"
-        elif tok[:1] == ["obj"]:
-            tok[1] = str((src.parent / tok[1]).resolve())
-            line = " ".join(tok)
-        elif tok[:2] == ["background", "image"]:
-            line = f"background image {(src.parent / tok[2]).resolve()}"
-        out.append(line)
-    p = tmp / f"{src.stem}_{scale}.scene"
-    p.write_text("\n".join(out) + "\n")
-    return p
+    w, h = pipeline.screen_of(src)
+    return scene_copy(src, tmp / f"{src.stem}_{scale}.scene", (w // scale, h // scale))
 
 
 def _gate(scene: Path, out: Path, min_psnr: float) -> dict:

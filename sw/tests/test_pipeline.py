@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from diffengine import anim, dc_harness, frame, functional, pipeline, reference
+from scene_files import scene_copy
 
 REPO = Path(__file__).resolve().parents[2]
 W, H = 32, 16
@@ -26,22 +27,7 @@ CHIPS = 4
 
 
 def _tiny(tmp: Path, src: Path, name: str, background: str | None = None) -> Path:
-    out = []
-    for line in src.read_text().splitlines():
-        tok = line.split()
-        if tok[:1] == ["screen"]:
-            line = f"screen {W} {H}"
-        elif tok[:1] == ["obj"]:
-            tok[1] = str((src.parent / tok[1]).resolve())
-            line = " ".join(tok)
-        elif tok[:2] == ["background", "image"]:
-            line = f"background image {(src.parent / tok[2]).resolve()}"
-        elif tok[:1] == ["background"] and background:
-            line = f"background {background}"
-        out.append(line)
-    p = tmp / name
-    p.write_text("\n".join(out) + "\n")
-    return p
+    return scene_copy(src, tmp / name, (W, H), background)
 
 
 @pytest.fixture(scope="module")
