@@ -153,12 +153,6 @@ static int classify_add(uint64_t db, uint64_t cb, void *vctx)
     return 2 + pos;
 }
 
-static int split_front(hsr_domain *const *res, int k)
-{
-    for (int pos = 0; pos <= k; pos++) if (!hsr_domain_is_empty(res[2 + pos])) return 1;
-    return 0;
-}
-
 /* The parents of LLR domain s join the accumulated hidden list acc of the
  * domain being added (deduplicated by mark_acc). */
 static hsr_status acc_parents(hsr_ctx *h, int s, ivec *acc, unsigned acc_mark)
@@ -254,13 +248,21 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         }
         int nlab = c.k + 3;
         hsr_domain *res[HSR_MAX_PREFIX + 3];
-        st = sweep_overlay_if(in, nin, hy, hb, nh, classify_add, &c, nlab, res, &c.saw_both);
+        int cnt[HSR_MAX_PREFIX + 3];
+        st = sweep_overlay_pieces(in, nin, hy, hb, nh, classify_add, &c, nlab, cnt);
         if (st != HSR_OK) goto done;
-        if (!c.saw_both) { for (int i = 0; i < nlab; i++) hsr_domain_free(res[i]); continue; }
+        if (!c.saw_both) continue;   /* nothing assembled */
+        /* which results are used (a label with no pieces is an empty domain) */
+        int split = c.covered, front = 0;
+        for (int pos = 0; pos <= c.k; pos++) front |= cnt[2 + pos] > 0;
+        split |= front;
+        unsigned char need[HSR_MAX_PREFIX + 3];
+        int all = split && !(c.covered && cnt[1] == 0 && !front);
+        for (int i = 0; i < nlab; i++) need[i] = (unsigned char)(i == 0 || all);
+        st = sweep_assemble(nlab, need, res);
+        if (st != HSR_OK) goto done;
         hsr_domain_free(rem);
         rem = res[0];
-        int split = c.covered;
-        for (int pos = 0; pos <= c.k; pos++) split |= !hsr_domain_is_empty(res[2 + pos]);
         if (!split) {
             /* The new domain is hidden wherever it meets N (no covered part, no new
              * front piece), so N keeps its shape: append id to N's hidden parents in
@@ -275,7 +277,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
             if (!listed && (!iv_push(&N->par, id) || !iv_push(&h->m[id].invis, s))) { st = HSR_ENOMEM; goto done; }
             continue;
         }
-        if (c.covered && hsr_domain_is_empty(res[1]) && !split_front(res, c.k)) {
+        if (c.covered && cnt[1] == 0 && !front) {
             /* I is opaque and in front of all of N: N disappears into the new
              * domain, which inherits all of N's parents as hidden ones.  Keep the
              * slot with the longest parent list for the new domain instead of

@@ -103,11 +103,16 @@ typedef int (*sweep_classify)(uint64_t dom_bits, uint64_t cut_bits, void *ctx);
 hsr_status sweep_overlay(const sweep_in *in, int nin, const int64_t *hcut_y,
                          const int *hcut_bit, int nhcut, sweep_classify fn,
                          void *ctx, int nlabels, hsr_domain **out);
-/* the same, but if keep != NULL and *keep == 0 once the sweep is done (the
- * classifier sets it), nothing is assembled: out[] are all NULL */
-hsr_status sweep_overlay_if(const sweep_in *in, int nin, const int64_t *hcut_y,
-                            const int *hcut_bit, int nhcut, sweep_classify fn,
-                            void *ctx, int nlabels, hsr_domain **out, const int *keep);
+/* The same in two steps.  sweep_overlay_pieces runs the sweep and leaves
+ * its output pieces in the sweep's scratch (until the next call); count[l]
+ * receives label l's number of pieces (0 exactly when out[l] would be
+ * empty).  sweep_assemble then builds out[l] for the labels with need[l]
+ * (all if need is NULL), the same domains sweep_overlay gives; the others
+ * are NULL.  Assembling only what the caller uses saves most of the work. */
+hsr_status sweep_overlay_pieces(const sweep_in *in, int nin, const int64_t *hcut_y,
+                                const int *hcut_bit, int nhcut, sweep_classify fn,
+                                void *ctx, int nlabels, int *count);
+hsr_status sweep_assemble(int nlabels, const unsigned char *need, hsr_domain **out);
 
 /* separate.c: depth order of surface p vs q, with the optional cut line */
 typedef struct pair_order {

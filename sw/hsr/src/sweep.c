@@ -10,8 +10,9 @@
  * overhead matters.  The working arrays are kept between calls (grown,
  * never shrunk; single-threaded use, as the qsort context already was),
  * the sorts are a stable merge sort (the same order glibc's qsort, a
- * stable merge sort, gave, so results are unchanged) and an overlay whose
- * result the caller will not use is not assembled (sweep_overlay_if). */
+ * stable merge sort, gave, so results are unchanged) and the output
+ * domains are assembled apart from the sweep, only those the caller will
+ * use (sweep_overlay_pieces, then sweep_assemble). */
 #include <stdlib.h>
 #include <string.h>
 #include "internal.h"
@@ -30,6 +31,7 @@ static struct scratch {
     int *idx; size_t capidx;                /* assemble: idx, indeg, adj_head, adj_next, adj_to, queue */
     edge *ed; size_t caped;
     int64_t *K; size_t capK;                /* integer slab boundaries */
+    int nlab;                               /* labels of the pieces in P */
 } S;
 
 static int grow(void **p, size_t *cap, size_t need, size_t sz)
@@ -112,7 +114,7 @@ static int slab_cmp(const sedge *a, const sedge *b, ry lo, ry hi)
 }
 
 /* Build out[label] from the pieces: join, then topological x-order. */
-static hsr_status assemble(piece *pc, int np, int nlabels, hsr_domain **out)
+static hsr_status assemble(piece *pc, int np, int nlabels, const unsigned char *need, hsr_domain **out)
 {
     size_t m0 = (size_t)(np ? np : 1);
     if (!GROW(S.lab, S.caplab, 3 * ((size_t)nlabels + 1)) || !GROW(S.idx, S.capidx, 6 * m0)
@@ -130,7 +132,7 @@ static hsr_status assemble(piece *pc, int np, int nlabels, hsr_domain **out)
     g_pieces = pc;
     for (int l = 0; l < nlabels; l++) {
         int *ix = idx + start[l], m = start[l + 1] - start[l], ne = 0;
-        if (m == 0) continue;
+        if (m == 0 || (need && !need[l])) continue;
         if (!sort_piece_idx(ix, (size_t)m)) return HSR_ENOMEM;
         for (int i = 0; i < m; i++) {
             piece *p = &pc[ix[i]];
@@ -177,13 +179,11 @@ static hsr_status assemble(piece *pc, int np, int nlabels, hsr_domain **out)
 #define PUSH(arr, n, cap, val) \
     do { if (!GROW(arr, cap, (n) + 1)) goto fail; (arr)[(n)++] = (val); } while (0)
 
-hsr_status sweep_overlay_if(const sweep_in *in, int nin, const int64_t *hcut_y,
-                            const int *hcut_bit, int nhcut, sweep_classify fn,
-                            void *ctx, int nlabels, hsr_domain **out, const int *keep)
+hsr_status sweep_overlay_pieces(const sweep_in *in, int nin, const int64_t *hcut_y,
+                                const int *hcut_bit, int nhcut, sweep_classify fn,
+                                void *ctx, int nlabels, int *count)
 {
-    hsr_status st = HSR_ENOMEM;
-    for (int l = 0; l < nlabels; l++) out[l] = NULL;
-    S.nE = S.nY = S.nP = 0;
+    S.nE = S.nY = S.nP = 0; S.nlab = 0;
     for (int i = 0; i < nin; i++)
         for (int j = 0; j < in[i].n; j++) {
             const edge *e = &in[i].e[j];
@@ -256,9 +256,21 @@ hsr_status sweep_overlay_if(const sweep_in *in, int nin, const int64_t *hcut_y,
             i = j;
         }
     }
-    if (keep && !*keep) return HSR_OK;   /* the caller discards the result */
-    for (int l = 0; l < nlabels; l++) if (!(out[l] = dom_new())) goto fail;
-    st = assemble(S.P, (int)S.nP, nlabels, out);
+    for (int l = 0; l < nlabels; l++) count[l] = 0;
+    for (size_t i = 0; i < S.nP; i++) count[S.P[i].label]++;
+    S.nlab = nlabels;
+    return HSR_OK;
+fail:
+    return HSR_ENOMEM;
+}
+
+hsr_status sweep_assemble(int nlabels, const unsigned char *need, hsr_domain **out)
+{
+    hsr_status st = HSR_ENOMEM;
+    for (int l = 0; l < nlabels; l++) out[l] = NULL;
+    if (nlabels != S.nlab) return HSR_EINVAL;
+    for (int l = 0; l < nlabels; l++) if ((!need || need[l]) && !(out[l] = dom_new())) goto fail;
+    st = assemble(S.P, (int)S.nP, nlabels, need, out);
     if (st != HSR_OK) goto fail;
     return HSR_OK;
 fail:
@@ -270,5 +282,9 @@ hsr_status sweep_overlay(const sweep_in *in, int nin, const int64_t *hcut_y,
                          const int *hcut_bit, int nhcut, sweep_classify fn,
                          void *ctx, int nlabels, hsr_domain **out)
 {
-    return sweep_overlay_if(in, nin, hcut_y, hcut_bit, nhcut, fn, ctx, nlabels, out, NULL);
+    int count[64 + 3];
+    for (int l = 0; l < nlabels; l++) out[l] = NULL;
+    if (nlabels < 1 || nlabels > (int)(sizeof count / sizeof *count)) return HSR_EINVAL;
+    hsr_status st = sweep_overlay_pieces(in, nin, hcut_y, hcut_bit, nhcut, fn, ctx, nlabels, count);
+    return st != HSR_OK ? st : sweep_assemble(nlabels, NULL, out);
 }
