@@ -133,6 +133,10 @@ int scene_face_project(const hsr_scene *sc, const scene_view *vw, int fi, double
 /* obj.c helpers shared with scene.c and mtl.c */
 int scene_grow(void **p, int *cap, int need, size_t sz);
 int scene_tokens(char *line, char **tok, int max);
+/* The next line at *p (moved past it), copied into buf and split into at most max
+ * tokens: the token count, -1 if the line does not fit in cap bytes, -2 if it has more
+ * than max items. */
+int scene_line(const char **p, char *buf, size_t cap, char **tok, int max);
 int scene_num(const char *s, double *v);
 /* scene.c: a whole text file (NUL bytes rejected); free() *text */
 hsr_status scene_read_file(const char *path, char **text);

@@ -41,16 +41,12 @@ hsr_status scene_mtl_load(hsr_scene *sc, const char *path, const char *where, ch
     const char *p = text;
     st = HSR_OK;
     while (*p) {
-        const char *e = strchr(p, '\n');
-        size_t n = e ? (size_t)(e - p) : strlen(p);
         lineno++;
 #define FAIL(s_, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", path, lineno); \
         if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } st = s_; goto done; } while (0)
-        if (n >= sizeof buf) FAIL(HSR_EPARSE, "line too long");
-        memcpy(buf, p, n); buf[n] = 0;
-        p = e ? e + 1 : p + n;
-        int nt = scene_tokens(buf, tok, 64);
-        if (nt < 0) FAIL(HSR_EPARSE, "too many items on one line");
+        int nt = scene_line(&p, buf, sizeof buf, tok, 64);
+        if (nt == -1) FAIL(HSR_EPARSE, "line too long");
+        if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
         if (nt == 0) continue;
         const char *k = tok[0];
         int known = !strcmp(k, "Kd") || !strcmp(k, "Ks") || !strcmp(k, "Ns") || !strcmp(k, "d") || !strcmp(k, "Tr");

@@ -38,6 +38,17 @@ int scene_tokens(char *line, char **tok, int max)
     return n;
 }
 
+int scene_line(const char **p, char *buf, size_t cap, char **tok, int max)
+{
+    const char *e = strchr(*p, '\n');
+    size_t n = e ? (size_t)(e - *p) : strlen(*p);
+    if (n >= cap) return -1;
+    memcpy(buf, *p, n); buf[n] = 0;
+    *p = e ? e + 1 : *p + n;
+    int nt = scene_tokens(buf, tok, max);
+    return nt < 0 ? -2 : nt;
+}
+
 int scene_num(const char *s, double *v)
 {
     char *end;
@@ -85,16 +96,12 @@ hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name, int 
     double pts[3 * 512];
     const char *p = text;
     while (*p) {
-        const char *e = strchr(p, '\n');
-        size_t n = e ? (size_t)(e - p) : strlen(p);
         lineno++;
 #define FAIL(st, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", name, lineno); \
         if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } return st; } while (0)
-        if (n >= sizeof buf) FAIL(HSR_EPARSE, "line too long");
-        memcpy(buf, p, n); buf[n] = 0;
-        p = e ? e + 1 : p + n;
-        int nt = scene_tokens(buf, tok, 512);
-        if (nt < 0) FAIL(HSR_EPARSE, "too many items on one line");
+        int nt = scene_line(&p, buf, sizeof buf, tok, 512);
+        if (nt == -1) FAIL(HSR_EPARSE, "line too long");
+        if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
         if (nt == 0) continue;
         if (!strcmp(tok[0], "v") || !strcmp(tok[0], "vn") || !strcmp(tok[0], "vt")) {
             int isv = tok[0][1] == 0, isn = tok[0][1] == 'n';
