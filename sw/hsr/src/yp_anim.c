@@ -44,12 +44,15 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
 {
     if (!path || !out) return HSR_EINVAL;
     *out = NULL;
-    FILE *f = fopen(path, "r");
-    if (!f) { if (err) snprintf(err, errlen, "%s: cannot read", path); return HSR_EIO; }
+    /* the whole file, then line by line: a line too long for the buffer is an error,
+     * not two lines (fgets would split it silently) */
+    char *f;
+    hsr_status rs = scene_read_file(path, &f);
+    if (rs != HSR_OK) { if (err) snprintf(err, errlen, "%s: cannot read (%s)", path, hsr_status_str(rs)); return rs; }
     yp_anim *a = calloc(1, sizeof *a);
-    if (!a) { fclose(f); return HSR_ENOMEM; }
+    if (!a) { free(f); return HSR_ENOMEM; }
     a->frames = 1;
-    char line[1024], dir[1024];
+    char line[4096], dir[1024];
     snprintf(dir, sizeof dir, "%s", path);
     char *sl = strrchr(dir, '/');
     if (sl) *sl = 0; else snprintf(dir, sizeof dir, ".");
@@ -57,11 +60,12 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
     hsr_status st = HSR_OK;
 #define AFAIL(...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", path, lineno); \
     if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } st = HSR_EPARSE; goto fail; } while (0)
-    while (fgets(line, sizeof line, f)) {
+    const char *text = f;
+    while (*text) {
         lineno++;
-        line[strcspn(line, "\n")] = 0;
         char *tok[16];
-        int nt = scene_tokens(line, tok, 16);
+        int nt = scene_line(&text, line, sizeof line, tok, 16);
+        if (nt == -1) AFAIL("line too long");
         if (nt < 0) AFAIL("too many items");
         if (nt == 0) continue;
         if (!strcmp(tok[0], "scene")) {
@@ -105,7 +109,7 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
         } else AFAIL("unknown statement '%s'", tok[0]);
     }
     if (!a->sc) AFAIL("no 'scene FILE'");
-    fclose(f); f = NULL;
+    free(f); f = NULL;
     hsr_scene *sc = a->sc;
     a->base_v = malloc(sizeof(double) * 3 * (size_t)(sc->nv + 1));
     a->base_op = malloc(sizeof(double) * (size_t)(sc->nmat + 1));
@@ -121,7 +125,7 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
     *out = a;
     return HSR_OK;
 fail:
-    if (f) fclose(f);
+    free(f);
     yp_anim_free(a);
     return st;
 #undef AFAIL

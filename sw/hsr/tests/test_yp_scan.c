@@ -363,6 +363,25 @@ static void test_yp_de48_stream_layout(void)
 /* animation: incremental HSR + re-scan of the damaged lines gives, frame
  * by frame, the same commands as a full rebuild, and lines outside the
  * damage do not change */
+/* An .anim line longer than the reader's buffer was read by fgets as two lines: the
+ * tail became a statement of its own (or was dropped if it looked like nothing). Now
+ * the whole file is read and such a line is an error naming its line. */
+static void test_yp_anim_line_too_long_is_one_error_not_two_lines(void)
+{
+    FILE *f = fopen("build/t_long.anim", "w");
+    if (!f) { CHECK(0); return; }
+    fputs("# ", f);
+    for (int i = 0; i < 5000; i++) fputc('a', f);
+    fputs("\nscene t_anim.scene\n", f);
+    fclose(f);
+    char err[256] = "";
+    yp_anim *an = NULL;
+    CHECK(yp_anim_load("build/t_long.anim", &an, err, sizeof err) == HSR_EPARSE);
+    CHECK(an == NULL);
+    CHECK(strstr(err, "build/t_long.anim:1: line too long") != NULL);
+    if (an) yp_anim_free(an);
+}
+
 static void test_yp_anim_incremental_equals_full_rebuild(void)
 {
     FILE *f = fopen("build/t_anim.obj", "w");
@@ -562,6 +581,7 @@ void suite_yp(void)
     RUN(test_yp_scene_exceeding_intensity_is_rejected);
     RUN(test_yp_de48_stream_layout);
     RUN(test_yp_anim_incremental_equals_full_rebuild);
+    RUN(test_yp_anim_line_too_long_is_one_error_not_two_lines);
     RUN(test_yp_no_wrap_at_full_intensity_and_black);
     RUN(test_yp_phong_sliver_missing_the_pixel_centre);
     RUN(test_yp_vertex_on_the_left_pixel_boundary_of_its_box);
