@@ -114,7 +114,7 @@ sim-merge: $(SETUP)
 
 # The outlier gate (issue 21) at full size: every shipped scene at 640x480 and the public
 # meshes with the 69K-triangle bunny (sw/tests/test_meshes.py; make test runs the shipped
-# scenes at 320x240 and leaves the bunny out). About 5 min on 2 cores.
+# scenes at 320x240 and leaves the bunny out). About 3.5 min on 2 cores.
 test-quality: $(SETUP)
 	@$(MAKE) -s -C sw/hsr build/yproc
 	$(ENV) cd sw && DE_QUALITY_FULL=1 $(PY) -m pytest -q -rA -n $(J) --durations=0 tests/test_meshes.py
