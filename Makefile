@@ -44,7 +44,8 @@ help:
 	@echo "make postsynth   yosys netlists simulated in Icarus against the golden model"
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
 	@echo "make setup       create .venv from scripts/requirements.txt"
-	@echo "make clean       remove build products (keeps .venv)"
+	@echo "make clean       remove every build product: out/, build/, sim/build, sim/out, sw/hsr/build,"
+	@echo "                 fpga/build, tb/*/sim_build* (keeps .venv and the ccache)"
 
 setup: $(SETUP)
 $(SETUP): scripts/setup.sh scripts/requirements.txt sw/pyproject.toml
@@ -161,4 +162,7 @@ postsynth: $(SETUP)
 	$(MAKE) -C fpga postsynth
 
 clean:
-	rm -rf $(OUT) build sim/out
+	rm -rf $(OUT) build sim/out sim/build sw/hsr/build fpga/build
+	find tb -name 'sim_build*' -prune -exec rm -rf {} +
+	rm -f tb/de_array/coverage_*.txt tb/de_array/seed_*.txt
+	git worktree prune 2>/dev/null || true

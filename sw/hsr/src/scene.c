@@ -103,6 +103,12 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             if (!(c[9] > 1 && c[9] < 179)) FAIL(HSR_EPARSE, "fov must be in (1, 179) degrees");
             memcpy(sc->eye, c, sizeof sc->eye); memcpy(sc->at, c + 3, sizeof sc->at);
             memcpy(sc->up, c + 6, sizeof sc->up); sc->fov_deg = c[9];
+            /* the same test the projection makes (scene_view_make), here where the line is known */
+            scene_view vw;
+            if (!scene_view_make(sc, &vw))
+                FAIL(HSR_EPARSE, "%s", c[0] == c[3] && c[1] == c[4] && c[2] == c[5]
+                     ? "camera eye and at are the same point: no view direction"
+                     : "camera up is zero or parallel to the view direction (eye - at)");
         } else if (!strcmp(k, "near")) {
             if (nt != 2 || !nums(tok + 1, 1, v) || !(v[0] > 0)) FAIL(HSR_EPARSE, "'near D' needs D > 0");
             sc->near_z = v[0];

@@ -58,6 +58,9 @@ static void test_malformed_input_errors_name_file_and_line(void)
     expect_err(0, "screen 10 10\nbogus 1\n", "s.scene:2: unknown statement 'bogus'");
     expect_err(0, "screen 0 10\n", "s.scene:1: 'screen W H'");
     expect_err(0, "camera eye 0 0 inf at 0 0 0 up 0 1 0 fov 60\n", "s.scene:1: bad or non-finite");
+    expect_err(0, "\ncamera eye 1 2 3 at 1 2 3 up 0 1 0 fov 60\n", "s.scene:2: camera eye and at are the same point");
+    expect_err(0, "camera eye 0 0 5 at 0 0 0 up 0 0 2 fov 60\n", "s.scene:1: camera up is zero or parallel");
+    expect_err(0, "camera eye 0 0 5 at 0 0 0 up 0 0 0 fov 60\n", "s.scene:1: camera up is zero or parallel");
     expect_err(0, "material m 1 0 0 opacity 2\n", "s.scene:1: opacity must be in [0,1]");
     expect_err(0, "\nobj missing.obj\n", "s.scene:2: cannot read OBJ file '/nonexistent/missing.obj'");
     expect_err(0, "obj a.obj material nope\n", "s.scene:1: unknown material 'nope'");

@@ -42,12 +42,17 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+static const char USAGE[] =
+    "usage: hsr_bench grid EXTENTS W SIZE NQ N1 [N2 ...]\n"
+    "       hsr_bench hsr SCENE [REPEAT]\n"
+    "       hsr_bench stack steps|spets N [REPEAT] [reverse]\n"
+    "       hsr_bench move SCENE_A SCENE_B K [REPEAT]\n"
+    "grid: Grid-List efficiency (Table 5.2); hsr: full build time; stack: tri-steps/spets\n"
+    "(Fig. 5.30); move: incremental move against a rebuild. Driven by the bench scripts.\n";
+
 static int usage(void)
 {
-    fprintf(stderr, "usage: hsr_bench grid EXTENTS W SIZE NQ N1 [N2 ...]\n"
-                    "       hsr_bench hsr SCENE [REPEAT]\n"
-                    "       hsr_bench stack steps|spets N [REPEAT] [reverse]\n"
-                    "       hsr_bench move SCENE_A SCENE_B K [REPEAT]\n");
+    fputs(USAGE, stderr);
     return 2;
 }
 
@@ -298,6 +303,8 @@ static int cmd_move(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { fputs(USAGE, stdout); return 0; }
     if (argc < 2) return usage();
     if (!strcmp(argv[1], "grid")) return cmd_grid(argc, argv);
     if (!strcmp(argv[1], "hsr")) return cmd_hsr(argc, argv);

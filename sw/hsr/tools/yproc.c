@@ -17,18 +17,40 @@
 #include <time.h>
 #include "hsr.h"
 
-int yproc_scan_main(int argc, char **argv);   /* yproc_scan.c part below */
+int yproc_scan_main(int argc, char **argv);   /* yproc_scan.c */
+int yproc_usage_error(const char *what, const char *arg);
 int yproc_apply_ops(hsr_ctx *h, const char *path, double **shade);   /* yproc_ops.c */
 
-static int usage(void)
+static const char USAGE[] =
+    "usage: yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json] [--svg FILE.svg]\n"
+    "                 [--stats] [--ops FILE] [--rebuild]\n"
+    "       yproc scan SCENE -o OUTDIR [--mode 640x480|640x485|1280x1024] [--no-aa]\n"
+    "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
+    "                  [--capacity SLOTS] [--expect]\n"
+    "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full]\n"
+    "\n"
+    "hsr   exact hidden-surface removal of SCENE (docs/hsr.md)\n"
+    "      --dump-llr F    the visible domains (LLR) as JSON     --dump-input F  the projected input faces\n"
+    "      --svg F         the visible domains as an SVG picture --stats         face and domain counts\n"
+    "      --ops F         incremental operations after the build (remove/move/add/opacity)\n"
+    "      --rebuild       then a full rebuild of the result, for comparison\n"
+    "scan  HSR, scan conversion and shading into r/g/b command streams in OUTDIR (docs/yproc.md)\n"
+    "      --mode M        video mode (default 640x480)          --no-aa         no anti-aliasing\n"
+    "      --shading S     flat, gouraud or phong                --frames N      render N times (timing)\n"
+    "      --cmd           also write the commands as text       --tol T         fit tolerance (>= 0.01)\n"
+    "      --capacity N    slots per line (>= 4; default: the mode's, Table 7.3)\n"
+    "      --expect        also write the expected pixels\n"
+    "anim  an animation (.anim) through the incremental pipeline, frame by frame\n"
+    "      --full          re-render every frame in full (the baseline)\n"
+    "\n"
+    "Errors are printed as \"file:line: message\" with exit status 1; a bad command line exits 2.\n";
+
+/* A help request anywhere on the line is answered on stdout with exit 0 (for scripts and
+ * `--help` checks); a bad command line names what is wrong and exits 2. */
+int yproc_usage_error(const char *what, const char *arg)
 {
-    fprintf(stderr, "usage: yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]"
-                    " [--svg FILE.svg] [--stats]\n"
-                    "                 [--ops FILE] [--rebuild]\n"
-                    "       yproc scan SCENE -o OUTDIR [--mode 640x480|640x485|1280x1024] [--no-aa]\n"
-                    "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
-                    "                  [--capacity SLOTS] [--expect]\n"
-                    "       yproc anim ANIMSCENE -o OUTDIR [same options] [--full]\n");
+    if (what) fprintf(stderr, "yproc: %s%s%s%s\n", what, arg ? " '" : "", arg ? arg : "", arg ? "'" : "");
+    fputs(USAGE, stderr);
     return 2;
 }
 
@@ -69,11 +91,13 @@ static hsr_status write_input_json(const char *path, const hsr_ctx *h, const hsr
 
 int main(int argc, char **argv)
 {
-    if (argc >= 3 && (!strcmp(argv[1], "scan") || !strcmp(argv[1], "anim"))) {
-        int rc = yproc_scan_main(argc, argv);
-        return rc == 2 ? usage() : rc;
-    }
-    if (argc < 3 || strcmp(argv[1], "hsr")) return usage();
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { fputs(USAGE, stdout); return 0; }
+    if (argc < 2) return yproc_usage_error("missing subcommand (hsr, scan or anim)", NULL);
+    if (strcmp(argv[1], "hsr") && strcmp(argv[1], "scan") && strcmp(argv[1], "anim"))
+        return yproc_usage_error("unknown subcommand", argv[1]);
+    if (argc < 3) return yproc_usage_error("missing scene file after", argv[1]);
+    if (strcmp(argv[1], "hsr")) return yproc_scan_main(argc, argv);
     const char *scene = argv[2], *json = NULL, *svg = NULL, *input = NULL, *ops = NULL;
     int stats = 0, rebuild = 0;
     for (int i = 3; i < argc; i++) {
@@ -83,7 +107,10 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--stats")) stats = 1;
         else if (!strcmp(argv[i], "--ops") && i + 1 < argc) ops = argv[++i];
         else if (!strcmp(argv[i], "--rebuild")) rebuild = 1;
-        else return usage();
+        else if (i + 1 == argc && (!strcmp(argv[i], "--dump-llr") || !strcmp(argv[i], "--dump-input")
+                                   || !strcmp(argv[i], "--svg") || !strcmp(argv[i], "--ops")))
+            return yproc_usage_error("missing value after", argv[i]);
+        else return yproc_usage_error("unknown option", argv[i]);
     }
     char err[1024] = "";
     hsr_scene *sc;

@@ -10,6 +10,7 @@
 #include "hsr.h"
 
 int yproc_scan_main(int argc, char **argv);
+int yproc_usage_error(const char *what, const char *arg);   /* yproc.c */
 
 /* process CPU time: the machine is shared, wall time would measure the
  * other processes too */
@@ -34,24 +35,35 @@ static int parse(int argc, char **argv, opts *o)
     int cap = 0;
     for (int i = 3; i < argc; i++) {
         const char *a = argv[i];
-        if (!strcmp(a, "-o") && i + 1 < argc) o->out = argv[++i];
-        else if (!strcmp(a, "--mode") && i + 1 < argc) { o->mode = argv[++i]; o->mode_given = 1; }
-        else if (!strcmp(a, "--no-aa")) o->yo.aa = 0;
+        int has_value = i + 1 < argc;
+        if (!strcmp(a, "--no-aa")) o->yo.aa = 0;
         else if (!strcmp(a, "--cmd")) o->cmd = 1;
         else if (!strcmp(a, "--expect")) o->expect = 1;
         else if (!strcmp(a, "--full")) o->full = 1;
-        else if (!strcmp(a, "--shading") && i + 1 < argc) {
+        else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
+                 && strcmp(a, "--tol") && strcmp(a, "--capacity"))
+            return yproc_usage_error("unknown option", a);
+        else if (!has_value) return yproc_usage_error("missing value after", a);
+        else if (!strcmp(a, "-o")) o->out = argv[++i];
+        else if (!strcmp(a, "--mode")) { o->mode = argv[++i]; o->mode_given = 1; }
+        else if (!strcmp(a, "--shading")) {
             const char *v = argv[++i];
             if (!strcmp(v, "flat")) o->yo.shading = YP_FLAT;
             else if (!strcmp(v, "gouraud")) o->yo.shading = YP_GOURAUD;
             else if (!strcmp(v, "phong")) o->yo.shading = YP_PHONG;
-            else return 2;
-        } else if (!strcmp(a, "--frames") && i + 1 < argc) { o->frames = atoi(argv[++i]); if (o->frames < 1) return 2; }
-        else if (!strcmp(a, "--tol") && i + 1 < argc) { o->yo.tol = atof(argv[++i]); if (!(o->yo.tol >= 0.01)) return 2; }
-        else if (!strcmp(a, "--capacity") && i + 1 < argc) { cap = atoi(argv[++i]); if (cap < 4) return 2; }
-        else return 2;
+            else return yproc_usage_error("--shading takes flat, gouraud or phong, not", v);
+        } else if (!strcmp(a, "--frames")) {
+            o->frames = atoi(argv[++i]);
+            if (o->frames < 1) return yproc_usage_error("--frames takes a count >= 1, not", argv[i]);
+        } else if (!strcmp(a, "--tol")) {
+            o->yo.tol = atof(argv[++i]);
+            if (!(o->yo.tol >= 0.01)) return yproc_usage_error("--tol takes a number >= 0.01, not", argv[i]);
+        } else {
+            cap = atoi(argv[++i]);
+            if (cap < 4) return yproc_usage_error("--capacity takes a slot count >= 4, not", argv[i]);
+        }
     }
-    if (!o->out) return 2;
+    if (!o->out) return yproc_usage_error("missing -o OUTDIR", NULL);
     o->yo.capacity = yp_mode_capacity(o->mode, &o->width, &o->height);
     if (!o->yo.capacity) { fprintf(stderr, "yproc: unknown mode '%s' (640x480, 640x485, 1280x1024)\n", o->mode); return 1; }
     if (cap) o->yo.capacity = cap;
@@ -383,6 +395,5 @@ int yproc_scan_main(int argc, char **argv)
     int r = parse(argc, argv, &o);
     if (r) return r;
     if (!strcmp(argv[1], "scan")) return scan_main(&o);
-    if (!strcmp(argv[1], "anim")) return anim_main(&o);
-    return 2;
+    return anim_main(&o);
 }
