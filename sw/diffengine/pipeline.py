@@ -23,10 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import binfmt, dc_harness, frame, functional, reference
+from . import binfmt, dc_harness, frame, functional, reference, yproc
 
 REPO = Path(__file__).resolve().parents[2]
-YPROC = REPO / "sw" / "hsr" / "build" / "yproc"
+YPROC = yproc.YPROC
 MIN_PSNR = 38.0
 H_TOTAL = 800          # 640x480's line: a 799-slot window, 798 usable (docs/pipeline.md 1.1)
 
@@ -111,11 +111,10 @@ def capacity(mode: int, test: tuple) -> int:
 
 
 def build_yproc() -> Path:
-    res = subprocess.run(["make", "-s", "-C", str(REPO / "sw" / "hsr"), "build/yproc"],
-                         capture_output=True, text=True)
-    if res.returncode or not YPROC.exists():
-        raise PipelineError("cannot build sw/hsr/build/yproc:\n" + res.stdout + res.stderr)
-    return YPROC
+    try:
+        return yproc.build()
+    except yproc.YprocError as e:
+        raise PipelineError(str(e)) from None
 
 
 def yproc_scan(scene: Path, outdir: Path, aa: bool = True, shading: str | None = None,

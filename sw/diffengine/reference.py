@@ -7,6 +7,10 @@ interpolation, local viewer, I_c = A kd_c + sum_l I_l,c (kd_c max(0, N.L) +
 KS max(0, E.R)^N), transparency o I_front + (1 - o) C_behind front to back over the
 `background`. 1.0 = 4095 pixel units.
 
+The scene, OBJ and MTL files are read by the C library, the project's one reader
+(`yproc read`, load_scene below); from there on everything is this module's own: the
+triangles' corner normals, projection, sampling and shading.
+
 Geometry mirrors sw/hsr/src/project.c exactly: the camera basis (w = eye - at, u = up x w,
 v = w x u), f = (H/2) / tan(fov/2), near clipping at z_eye <= -near in eye space, screen
 x = W/2 + f x_e / -z_e, y = H/2 - f y_e / -z_e (y down), vertices quantised to
@@ -26,7 +30,6 @@ from __future__ import annotations
 
 import math
 import sys
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -73,20 +76,6 @@ class Scene:
     mat: np.ndarray = None
 
 
-def _nums(tok, n, where):
-    try:
-        v = [float(t) for t in tok[:n]]
-    except ValueError:
-        raise SceneError(f"{where}: bad number") from None
-    if len(v) != n or not all(math.isfinite(x) for x in v):
-        raise SceneError(f"{where}: needs {n} finite numbers")
-    return v
-
-
-def _tokens(line: str) -> list[str]:
-    return line.split("#", 1)[0].split()
-
-
 def _newell(p: np.ndarray) -> np.ndarray:
     """Newell normal of polygon(s) p (..., n, 3): unnormalised, |.| = 2 area."""
     q = np.roll(p, -1, axis=-2)
@@ -95,273 +84,66 @@ def _newell(p: np.ndarray) -> np.ndarray:
                      ((p[..., 0] - q[..., 0]) * (p[..., 1] + q[..., 1])).sum(-1)], -1)
 
 
-# --- OBJ and MTL, as sw/hsr/src/obj.c, mtl.c and poly.c read them (docs/hsr.md) -------
-
-_MAX_LINE = 4095          # obj.c: a line of 4096 characters or more is an error
-_MAX_ITEMS = 512          # obj.c: tokens per line
-PLANAR_TOL = 1e-6         # poly.c: a polygon is planar to 1e-6 of its bounding box diagonal
-
-
-def _read_text(path: Path, what: str, where: str) -> str:
+def load_scene(path) -> Scene:
+    """The scene file and its OBJ/MTL files, read by the C library (`yproc read`, one
+    reader for every format: docs/hsr.md "hsr-scene-1"); the triangles and their corner
+    normals are made here (docs/shading.md "Normals"), so the shading stays this module's.
+    SceneError carries the reader's "file:line: message"."""
+    from . import yproc
     try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise SceneError(f"{where}cannot read {what} file '{path}' ({e.strerror})") from None
-    if b"\0" in data:
-        raise SceneError(f"{where}cannot read {what} file '{path}' (NUL byte)")
-    return data.decode("utf-8", errors="surrogateescape")
+        d = yproc.read_scene(path)
+    except yproc.YprocError as e:
+        raise SceneError(str(e)) from None
+    cam = d["camera"]
+    sc = Scene(width=d["screen"][0], height=d["screen"][1], eye=tuple(cam["eye"]),
+               at=tuple(cam["at"]), up=tuple(cam["up"]), fov=cam["fov"], near=cam["near"],
+               ambient=d["ambient"], background=tuple(d["background"]))
+    sc.materials = [Material(m["name"], tuple(m["kd"]), m["opacity"], m["ks"], m["n"], m["flat"])
+                    for m in d["materials"]]
+    for lt in d["lights"]:
+        L = np.array(lt["dir"], dtype=np.float64)
+        sc.lights.append((L / np.linalg.norm(L), np.array(lt["rgb"], dtype=np.float64)))
+    _triangles(sc, d)
+    if d["background_image"] is not None:
+        sc.background_image = _read_ppm(Path(d["background_image"]),
+                                        f"{d['file']}:{d['background_image_line']}",
+                                        sc.width, sc.height)
+    return sc
 
 
-def _lines(text: str, name):
-    """(line number, tokens) as obj.c's scene_tokens: split on space, tab and CR, a token
-    starting with '#' ends the line."""
-    for lineno, line in enumerate(text.split("\n"), 1):
-        if len(line) > _MAX_LINE // 4 and len(line.encode("utf-8", "surrogateescape")) > _MAX_LINE:
-            raise SceneError(f"{name}:{lineno}: line too long")   # bytes, as in C
-        tok = []
-        for t in line.replace("\t", " ").replace("\r", " ").split(" "):
-            if not t:
-                continue
-            if t[0] == "#":
-                break
-            tok.append(t)
-        if len(tok) > _MAX_ITEMS:
-            raise SceneError(f"{name}:{lineno}: too many items on one line")
-        if tok:
-            yield lineno, tok
-
-
-def _num(t: str) -> float | None:
-    """strtod + isfinite: a finite number, or None."""
-    if not t.isascii() or "_" in t:
-        return None
-    try:
-        v = float.fromhex(t) if "0x" in t.lower() else float(t)
-    except ValueError:
-        return None
-    return v if math.isfinite(v) else None
-
-
-def _int(t: str) -> int | None:
-    if not t or not t.isascii() or "_" in t or t.strip() != t:
-        return None
-    try:
-        return int(t, 10)
-    except ValueError:
-        return None
-
-
-def _triangulate(P) -> tuple[list, bool]:
-    """poly.c's poly_triangulate on points P (n, 3) as Python floats, the same arithmetic in
-    the same order: (triangles as index triples, whole), whole = convex and planar."""
-    n = len(P)
-    N = [0.0, 0.0, 0.0]
-    lo, hi, c = list(P[0]), list(P[0]), [0.0, 0.0, 0.0]
-    for a in range(n):
-        p, r = P[a], P[(a + 1) % n]
-        N[0] += (p[1] - r[1]) * (p[2] + r[2])
-        N[1] += (p[2] - r[2]) * (p[0] + r[0])
-        N[2] += (p[0] - r[0]) * (p[1] + r[1])
-        for k in range(3):
-            c[k] += p[k]
-            lo[k] = min(lo[k], p[k])
-            hi[k] = max(hi[k], p[k])
-    ax = 0
-    if abs(N[1]) > abs(N[ax]):
-        ax = 1
-    if abs(N[2]) > abs(N[ax]):
-        ax = 2
-    i, j, sign = (ax + 1) % 3, (ax + 2) % 3, (1.0 if N[ax] >= 0 else -1.0)
-
-    def cross2(a, b, cc):
-        A, B, C = P[a], P[b], P[cc]
-        return sign * ((B[i] - A[i]) * (C[j] - A[j]) - (B[j] - A[j]) * (C[i] - A[i]))
-
-    cv = all(cross2((k + n - 1) % n, k, (k + 1) % n) >= 0 for k in range(n)) and \
-        all(cross2(0, k, k + 1) >= 0 and cross2(0, 1, k + 1) >= 0 for k in range(1, n - 1))
-    ln = math.sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2])
-    diag = math.sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1])
-                     + (hi[2] - lo[2]) * (hi[2] - lo[2]))
-    dev = 0.0
-    if ln > 0:
-        for a in range(n):
-            d = 0.0
-            for k in range(3):
-                d += (P[a][k] - c[k] / n) * (N[k] / ln)
-            dev = max(dev, abs(d))
-    whole = n == 3 or (cv and ln > 0 and dev <= PLANAR_TOL * diag)
-    tris = []
-    if not cv:
-        idx = list(range(n))
-        while len(idx) > 3:
-            m, found = len(idx), -1
-            for k in range(m):
-                a, b, cc = idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]
-                if not cross2(a, b, cc) > 0:
-                    continue
-                if any(t not in (a, b, cc) and cross2(a, b, t) >= 0 and cross2(b, cc, t) >= 0
-                       and cross2(cc, a, t) >= 0 for t in idx):
-                    continue
-                found = k
-                break
-            if found < 0:
-                break           # self-intersecting or degenerate: fan the rest
-            tris.append((idx[(found + m - 1) % m], idx[found], idx[(found + 1) % m]))
-            del idx[found]
-        tris += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
-        return tris, whole
-    return [(0, k, k + 1) for k in range(1, n - 1)], whole
-
-
-def _read_mtl(path: Path, where: str, materials: list) -> dict[str, int]:
-    """mtl.c: append the .mtl file's materials; returns name -> index (last one counts)."""
-    text = _read_text(path, "MTL", where + ": ")
-    found: dict[str, int] = {}
-    cur = None
-    for lineno, tok in _lines(text, path):
-        k, at = tok[0], f"{path}:{lineno}"
-        if k == "newmtl":
-            if len(tok) != 2:
-                raise SceneError(f"{at}: 'newmtl' needs one name")
-            if len(tok[1].encode("utf-8", "surrogateescape")) >= 64:
-                raise SceneError(f"{at}: material name too long")
-            cur = Material(tok[1], (0.8, 0.8, 0.8))
-            found[tok[1]] = len(materials)
-            materials.append(cur)
-            continue
-        if k not in ("Kd", "Ks", "Ns", "d", "Tr"):
-            continue
-        if cur is None:
-            raise SceneError(f"{at}: '{k}' before 'newmtl'")
-        if k in ("Kd", "Ks"):
-            v = [_num(t) for t in tok[1:]]
-            if len(v) not in (1, 3) or None in v:
-                raise SceneError(f"{at}: '{k}' needs 1 or 3 finite numbers (spectral and xyz "
-                                 "are not read)")
-            rgb = (v[0],) * 3 if len(v) == 1 else tuple(v)
-            if k == "Kd":
-                cur.kd = rgb
-            else:
-                if min(rgb) < 0:
-                    raise SceneError(f"{at}: 'Ks' must be >= 0")
-                cur.ks = (rgb[0] + rgb[1] + rgb[2]) / 3
-        elif k == "Ns":
-            v = _num(tok[1]) if len(tok) == 2 else None
-            if v is None or v < 0:
-                raise SceneError(f"{at}: 'Ns' needs one finite number >= 0")
-            cur.n = max(v, 1.0)
-        else:
-            v = _num(tok[1]) if len(tok) == 2 else None
-            if v is None or not 0 <= v <= 1:
-                raise SceneError(f"{at}: '{k}' needs one number in [0,1]")
-            cur.opacity = v if k == "d" else 1 - v
-    return found
-
-
-def _read_obj(path: Path, default_mat: int, names: dict[str, int], materials: list,
-              tris, norms, mats, where: str = "") -> None:
-    """Append the OBJ's triangles, as obj.c reads the file (docs/hsr.md "OBJ") and
-    yp_shade.c gives their corners normals (docs/shading.md "Normals")."""
-    text = _read_text(path, "OBJ", where)
-    verts, vns = [], []
-    nvt = 0
-    polys = []      # (vertex idx list, normal idx list (None = none), material, group)
-    cur, group, mine = default_mat, -1, {}
-    for lineno, tok in _lines(text, path):
-        at, k = f"{path}:{lineno}", tok[0]
-        if k in ("v", "vn", "vt"):
-            if k == "v" and len(tok) not in (4, 5, 7):
-                raise SceneError(f"{at}: 'v' needs 3 coordinates (then w, or r g b)")
-            if k == "vn" and len(tok) != 4:
-                raise SceneError(f"{at}: 'vn' needs 3 numbers")
-            if k == "vt" and not 2 <= len(tok) <= 4:
-                raise SceneError(f"{at}: 'vt' needs 1 to 3 numbers")
-            x = []
-            for t in tok[1:]:
-                v = _num(t)
-                if v is None:
-                    raise SceneError(f"{at}: bad or non-finite number '{t}'")
-                x.append(v)
-            if k == "v":
-                verts.append(x[:3])
-            elif k == "vn":
-                if x == [0.0, 0.0, 0.0]:
-                    raise SceneError(f"{at}: 'vn' has zero length")
-                vns.append(x)
-            else:
-                nvt += 1
-        elif k == "f":
-            if len(tok) < 4:
-                raise SceneError(f"{at}: face needs at least 3 vertices")
-            vi, ni = [], []
-            for t in tok[1:]:
-                parts = t.split("/")
-                bad = len(parts) > 3 or parts[0] == "" or (len(parts) == 2 and parts[1] == "")
-                raw = []
-                for q in parts:
-                    r = None if q == "" else (_int(q) if len(q) < 32 else None)
-                    bad |= q != "" and r is None
-                    raw.append(r)
-                if bad:
-                    raise SceneError(f"{at}: bad vertex index '{t}' (v, v/vt, v//vn or "
-                                     "v/vt/vn)")
-                raw += [None] * (3 - len(raw))
-                idx = []
-                for which, r, cnt in zip(("vertex", "texture", "normal"), raw,
-                                         (len(verts), nvt, len(vns))):
-                    q = None if r is None else r - 1 if r > 0 else cnt + r if r < 0 else -1
-                    if q is not None and not 0 <= q < cnt:
-                        raise SceneError(f"{at}: {which} index {r} out of range (1..{cnt})")
-                    idx.append(q)
-                vi.append(idx[0])
-                ni.append(idx[2])
-            polys.append((vi, ni, cur, group))
-        elif k == "s":
-            g = 0 if len(tok) == 2 and tok[1] == "off" else (_int(tok[1]) if len(tok) == 2
-                                                            else None)
-            if g is None or not 0 <= g <= 2147483647:
-                raise SceneError(f"{at}: 's' needs a group number >= 0 or 'off'")
-            group = g
-        elif k == "mtllib":
-            if len(tok) < 2:
-                raise SceneError(f"{at}: 'mtllib' needs a file name")
-            for t in tok[1:]:
-                mine.update(_read_mtl(Path(t) if t.startswith("/") else path.parent / t, at,
-                                      materials))
-        elif k == "usemtl":
-            # a scene-file material of that name, else this file's .mtl ones read so far,
-            # else the obj statement's material
-            if len(tok) != 2:
-                raise SceneError(f"{at}: 'usemtl' needs one name")
-            cur = names.get(tok[1], mine.get(tok[1], default_mat))
-    if not polys:
+def _triangles(sc: Scene, d: dict) -> None:
+    """sc.pos / nrm / mat from the reader's faces. A face is a polygon the reader kept
+    whole (convex and planar), drawn as its fan, or one triangle of a polygon it split
+    (consecutive faces with the same `poly`). Corner normals: an authored `vn`, else `s off`
+    the face normal, else the normalised sum over the polygons of the vertex's smoothing
+    group of their normals; a `flat` material takes the face normal everywhere."""
+    V = np.array(d["vertices"], dtype=np.float64).reshape(-1, 3)
+    VN = np.array(d["normals"], dtype=np.float64).reshape(-1, 3)
+    F = {k: np.array(v, dtype=np.int64) for k, v in d["faces"].items()}
+    cv_all = np.array(d["corners"]["vertex"], dtype=np.int64)
+    cn_all = np.array(d["corners"]["normal"], dtype=np.int64)
+    if len(F["first"]) == 0:
+        sc.pos, sc.nrm, sc.mat = np.zeros((0, 3, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64)
         return
-    V = np.array(verts, dtype=np.float64)
-    VN = np.array(vns, dtype=np.float64) if vns else np.zeros((0, 3))
-    # triangles: corner vertex / normal indices, polygon, whole (convex and planar: one
-    # face in the C reader, its fan here), smoothing group, material
-    tv, tn, tp, tw, tg, tm = [], [], [], [], [], []
-    for k, (vi, ni, m, g) in enumerate(polys):
-        tri, whole = _triangulate([verts[v] for v in vi]) if len(vi) > 3 else ([(0, 1, 2)], True)
-        for t in tri:
-            tv.append([vi[c] for c in t])
-            tn.append([-1 if ni[c] is None else ni[c] for c in t])
-        tp += [k] * len(tri)
-        tw += [whole] * len(tri)
-        tg += [g] * len(tri)
-        tm += [m] * len(tri)
-    tv, tn, tp, tg = (np.array(x, dtype=np.int64) for x in (tv, tn, tp, tg))
-    tw = np.array(tw, dtype=bool)
+    # the fan of each face: (face, 0, k, k + 1) corner offsets
+    nt = F["count"] - 2
+    tf = np.repeat(np.arange(len(nt)), nt)
+    k = np.arange(len(tf)) - np.repeat(np.cumsum(nt) - nt, nt) + 1
+    corners = F["first"][tf][:, None] + np.stack([np.zeros_like(k), k, k + 1], 1)
+    tv, tn = cv_all[corners], cn_all[corners]
+    tp, tg, tm = F["poly"][tf], F["smooth"][tf], F["material"][tf]
     tpos = V[tv]                                          # (T, 3, 3)
     tnewell = _newell(tpos)                               # (T, 3), |.| = 2 area
-    pn = np.zeros((len(polys), 3))                        # the polygon's Newell normal
+    npoly = int(tp.max()) + 1
+    pn = np.zeros((npoly, 3))                             # the polygon's normal
     np.add.at(pn, tp, tnewell)
-    # the face normal: the polygon's if it is one face in the C reader, else the triangle's
-    fn = np.where(tw[:, None], pn[tp], tnewell)
+    # the face normal: the polygon's if the reader kept it whole, else the triangle's
+    faces_of_poly = np.bincount(F["poly"], minlength=npoly)
+    whole = faces_of_poly[tp] == 1
+    fn = np.where(whole[:, None], pn[tp], tnewell)
     # smooth normals per (vertex, group): each polygon of the group using the vertex once
-    cv = np.array([v for vi, _, _, _ in polys for v in vi], dtype=np.int64)
-    cg = np.array([g for vi, _, _, g in polys for _ in vi], dtype=np.int64)
-    cp = np.array([k for k, (vi, _, _, _) in enumerate(polys) for _ in vi], dtype=np.int64)
+    cf = np.repeat(np.arange(len(F["first"])), F["count"])    # the face of every corner
+    cv, cg, cp = cv_all[:len(cf)], F["smooth"][cf], F["poly"][cf]
     groups, cgi = np.unique(cg, return_inverse=True)
     ng = len(groups)
     vg_key = cv * ng + cgi.reshape(-1)
@@ -377,111 +159,9 @@ def _read_obj(path: Path, default_mat: int, names: dict[str, int], materials: li
     nrm[flat] = fn[flat][:, None, :]
     authored = tn >= 0                                    # `vn` overrides
     nrm[authored] = VN[tn[authored]]
-    tris.extend(tpos)
-    norms.extend(nrm)
-    mats.extend(zip(tm, fn))
-
-
-def load_scene(path) -> Scene:
-    """Parse a scene file (docs/hsr.md + docs/shading.md extensions) and its OBJ files."""
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as e:
-        raise SceneError(f"{path}: cannot read ({e.strerror})") from None
-    sc = Scene()
-    sc.materials = [Material("default", (0.8, 0.8, 0.8))]
-    names = {"default": 0}
-    tris, norms, mats = [], [], []
-    bg_image = None
-    for lineno, line in enumerate(text.splitlines(), 1):
-        tok = _tokens(line)
-        if not tok:
-            continue
-        k, where = tok[0], f"{path}:{lineno}"
-        if k == "screen":
-            w, h = _nums(tok[1:], 2, where)
-            sc.width, sc.height = int(w), int(h)
-        elif k == "camera":
-            if len(tok) != 15 or (tok[1], tok[5], tok[9], tok[13]) != ("eye", "at", "up", "fov"):
-                raise SceneError(f"{where}: expected 'camera eye X Y Z at X Y Z up X Y Z fov DEG'")
-            sc.eye = tuple(_nums(tok[2:5], 3, where))
-            sc.at = tuple(_nums(tok[6:9], 3, where))
-            sc.up = tuple(_nums(tok[10:13], 3, where))
-            sc.fov = _nums(tok[14:], 1, where)[0]
-        elif k == "near":
-            sc.near = _nums(tok[1:], 1, where)[0]
-        elif k == "light":
-            if len(tok) == 5:
-                v = _nums(tok[1:], 4, where)
-                rgb = (v[3],) * 3
-            elif len(tok) == 7:
-                v = _nums(tok[1:], 6, where)
-                rgb = tuple(v[3:6])
-            else:
-                raise SceneError(f"{where}: 'light DX DY DZ I' or 'light DX DY DZ R G B'")
-            L = np.array(v[:3])
-            if not np.linalg.norm(L) > 0:
-                raise SceneError(f"{where}: zero light direction")
-            sc.lights.append((L / np.linalg.norm(L), np.array(rgb, dtype=np.float64)))
-        elif k == "ambient":
-            sc.ambient = _nums(tok[1:], 1, where)[0]
-        elif k == "background" and len(tok) == 3 and tok[1] == "image":
-            bg_image = (path.parent / tok[2], where)
-        elif k == "background":
-            sc.background = tuple(_nums(tok[1:], 3, where))
-        elif k == "material":
-            if len(tok) < 5:
-                raise SceneError(f"{where}: expected 'material NAME R G B [opacity O] "
-                                 "[specular KS N] [flat]'")
-            m = Material(tok[1], tuple(_nums(tok[2:5], 3, where)))
-            i = 5
-            while i < len(tok):
-                if tok[i] == "opacity":
-                    m.opacity = _nums(tok[i + 1:i + 2], 1, where)[0]
-                    i += 2
-                elif tok[i] == "specular":
-                    m.ks, m.n = _nums(tok[i + 1:i + 3], 2, where)
-                    i += 3
-                elif tok[i] in ("flat", "smooth"):
-                    m.flat = tok[i] == "flat"
-                    i += 1
-                elif tok[i] == "shading" and i + 1 < len(tok):
-                    m.flat = tok[i + 1] == "flat"
-                    i += 2
-                else:
-                    raise SceneError(f"{where}: unknown material option {tok[i]!r}")
-            names[m.name] = len(sc.materials)
-            sc.materials.append(m)
-        elif k == "obj":
-            if len(tok) == 4 and tok[2] == "material":
-                if tok[3] not in names:
-                    raise SceneError(f"{where}: unknown material {tok[3]!r}")
-                mat = names[tok[3]]
-            elif len(tok) == 2:
-                mat = 0
-            else:
-                raise SceneError(f"{where}: expected 'obj PATH [material NAME]'")
-            p = Path(tok[1])
-            _read_obj(p if p.is_absolute() else path.parent / p, mat, names, sc.materials,
-                      tris, norms, mats, where=f"{where}: ")
-        elif k == "grid":
-            pass
-        else:
-            warnings.warn(f"{where}: statement {k!r} ignored by the reference renderer",
-                          stacklevel=2)
-    if not sc.lights:   # scene.c's default light
-        sc.lights.append((np.ones(3) / math.sqrt(3), np.full(3, 0.8)))
-    sc.pos = np.array(tris, dtype=np.float64).reshape(-1, 3, 3)
-    nv = np.array(norms, dtype=np.float64).reshape(-1, 3, 3)
-    midx = np.array([m for m, _ in mats], dtype=np.int64)
-    fnorm = np.array([n for _, n in mats], dtype=np.float64).reshape(-1, 3)
-    flat = np.array([sc.materials[m].flat for m in midx], dtype=bool)
-    nv[flat] = fnorm[flat][:, None, :]
-    sc.nrm, sc.mat = nv, midx
-    if bg_image is not None:
-        sc.background_image = _read_ppm(*bg_image, sc.width, sc.height)
-    return sc
+    flat_mat = np.array([m.flat for m in sc.materials], dtype=bool)[tm]
+    nrm[flat_mat] = fn[flat_mat][:, None, :]
+    sc.pos, sc.nrm, sc.mat = tpos, nrm, tm
 
 
 def _read_ppm(path: Path, where: str, W: int, H: int) -> np.ndarray:

@@ -71,7 +71,7 @@ import shapely
 from shapely.geometry import LineString, Point, Polygon, box
 from shapely.ops import polygonize, unary_union
 
-from diffengine import reference
+from diffengine import yproc as yproc_tool
 
 ROOT = Path(__file__).resolve().parents[2]
 HSR = ROOT / "sw" / "hsr"
@@ -184,17 +184,17 @@ def make_scene(kind: str, rng) -> tuple[list[list[tuple]], list[int], dict]:
     return faces, fm, mats
 
 
-def as_read(faces, fm):
-    """The faces as the OBJ readers store them (docs/hsr.md "OBJ", polygons): a polygon
-    that is not convex and planar (make_scene's random radii can make one concave)
-    becomes its triangles, consecutive MLR ids."""
-    out, om = [], []
-    for f, m in zip(faces, fm):
-        tris, whole = reference._triangulate([[float(x) for x in p] for p in f])
-        for t in [range(len(f))] if whole else tris:
-            out.append([f[i] for i in t])
-            om.append(m)
-    return out, om
+def as_read(scene: Path, mats):
+    """The faces and their material keys as the reader stores them (`yproc read`,
+    docs/hsr.md "OBJ", polygons): a polygon that is not convex and planar (make_scene's
+    random radii can make one concave) becomes its triangles, consecutive MLR ids."""
+    d = yproc_tool.read_scene(scene)
+    V = d["vertices"]
+    key = {name: k for k, (name, _) in mats.items()}
+    names = [m["name"] for m in d["materials"]]
+    cv, F = d["corners"]["vertex"], d["faces"]
+    faces = [[tuple(V[c]) for c in cv[a:a + n]] for a, n in zip(F["first"], F["count"])]
+    return faces, [key[names[m]] for m in F["material"]]
 
 
 def write_scene(tmp: Path, faces, fm, mats) -> Path:
@@ -561,7 +561,7 @@ def test_hsr_oracle(yproc, tmp_path, kind, idx):
     rng = np.random.default_rng(seed)
     faces, fm, mats = make_scene(kind, rng)
     scene = write_scene(tmp_path, faces, fm, mats)
-    faces, fm = as_read(faces, fm)
+    faces, fm = as_read(scene, mats)
     inp, llr = run_yproc(yproc, scene, tmp_path)
     where = f"[{kind}{idx}] seed {seed} (SEED={base} replays)"
 
@@ -715,7 +715,7 @@ def test_hsr_incremental(yproc, tmp_path, kind, idx):
     rng = np.random.default_rng(seed)
     faces, fm, mats = make_scene(kind, rng)
     scene = write_scene(tmp_path, faces, fm, mats)
-    faces, fm = as_read(faces, fm)
+    faces, fm = as_read(scene, mats)
     ops = random_ops(rng, len(faces), int(rng.integers(8, 21)))
     opsf = tmp_path / "ops.txt"
     opsf.write_text("# test_hsr_incremental\n" + "\n".join(ops) + "\n")

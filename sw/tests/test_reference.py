@@ -9,12 +9,15 @@ clipping. Each renders at most a few thousand pixels (whole file < 15 s).
 from __future__ import annotations
 
 import math
+import re
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from diffengine import reference as ref
+from diffengine import yproc
 
 S = 4095.0
 
@@ -255,3 +258,8 @@ def test_background_image_bad_file_names_scene_line(tmp_path, data, msg):
     sc = write(tmp_path, CAM + "\nbackground image bg.ppm\n", {})
     with pytest.raises(ref.SceneError, match=rf"s.scene:4: .*{msg}"):
         ref.load_scene(sc)
+    # the y-processor names the same line
+    exe = yproc.build()
+    r = subprocess.run([str(exe), "scan", str(sc), "-o", str(tmp_path / "out")],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and re.search(rf"s.scene:4: .*{msg}", r.stderr), r.stderr

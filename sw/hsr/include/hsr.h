@@ -193,6 +193,7 @@ typedef struct hsr_scene {
     int nobj;                         /* `obj` statements read */
     int ambient_line;                 /* scene-file line of `ambient` (0: default) */
     char bg_image[4096];              /* `background image FILE` (binary PPM), "" = none */
+    int bg_image_line;                /* its scene-file line (messages) */
     char name[1024];                  /* scene file path (messages), "" if parsed from text */
 } hsr_scene;
 
@@ -213,6 +214,10 @@ hsr_status hsr_scene_load(const char *path, hsr_scene **out, char *err, size_t e
 hsr_status hsr_scene_build(const hsr_scene *sc, hsr_ctx **out, double **shade);
 /* --dump-llr JSON and SVG writers (schema in docs/hsr.md). */
 hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scene *sc);
+/* `yproc read`: the scene as read (camera, lights, materials, vertices, `vn`, faces with
+ * their corners, smoothing groups and polygons), schema "hsr-scene-1" in docs/hsr.md:
+ * the geometry the Python reference renderer draws, so the formats have one reader. */
+hsr_status hsr_write_scene_json(const char *path, const hsr_scene *sc);
 hsr_status hsr_write_svg(const char *path, const hsr_ctx *h, const hsr_scene *sc,
                          const double *shade);
 

@@ -135,6 +135,7 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             if (nt == 3 && !strcmp(tok[1], "image")) {
                 if (tok[2][0] == '/' || !dir) snprintf(sc->bg_image, sizeof sc->bg_image, "%s", tok[2]);
                 else snprintf(sc->bg_image, sizeof sc->bg_image, "%s/%s", dir, tok[2]);
+                sc->bg_image_line = lineno;
                 continue;
             }
             if (nt != 4 || !nums(tok + 1, 3, v)) FAIL(HSR_EPARSE, "'background R G B' needs 3 numbers");

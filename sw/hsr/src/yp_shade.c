@@ -8,7 +8,7 @@
 #include <string.h>
 #include "yp_internal.h"
 
-static hsr_status read_ppm(const char *path, int W, int H, uint16_t **out, char *err, size_t errlen);
+static hsr_status read_ppm(const char *path, const char *where, int W, int H, uint16_t **out, char *err, size_t errlen);
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static int unit3(double *a)
@@ -310,7 +310,11 @@ hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out, 
         }
     }
     hsr_status st = yp_shader_update(s, sc);
-    if (st == HSR_OK && sc->bg_image[0]) st = read_ppm(sc->bg_image, sc->width, sc->height, &s->img, err, errlen);
+    if (st == HSR_OK && sc->bg_image[0]) {
+        char where[1100];   /* "scene:line" of the `background image` statement */
+        snprintf(where, sizeof where, "%s:%d", sc->name[0] ? sc->name : "scene", sc->bg_image_line);
+        st = read_ppm(sc->bg_image, where, sc->width, sc->height, &s->img, err, errlen);
+    }
     if (st != HSR_OK) { yp_shader_free(s); return st; }
     *out = s;
     return HSR_OK;
@@ -318,15 +322,15 @@ hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out, 
 
 /* binary PPM (P6, maxval 1..65535) -> 12-bit [3][H][W], scaled to the
  * screen by nearest neighbour; simple enough to read without a library. */
-static hsr_status read_ppm(const char *path, int W, int H, uint16_t **out, char *err, size_t errlen)
+static hsr_status read_ppm(const char *path, const char *where, int W, int H, uint16_t **out, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "rb");
-    if (!f) { if (err) snprintf(err, errlen, "%s: cannot read background image", path); return HSR_EIO; }
+    if (!f) { if (err) snprintf(err, errlen, "%s: cannot read background image %s", where, path); return HSR_EIO; }
     int w, h, maxv;
     char m[3] = {0};
     if (fscanf(f, "%2s %d %d %d", m, &w, &h, &maxv) != 4 || strcmp(m, "P6") || maxv < 1 || maxv > 65535 || fgetc(f) == EOF) {
         fclose(f);
-        if (err) snprintf(err, errlen, "%s: not a binary PPM (P6)", path);
+        if (err) snprintf(err, errlen, "%s: %s: not a binary PPM (P6)", where, path);
         return HSR_EPARSE;
     }
     /* any size: scaled to the screen by nearest neighbour */
@@ -337,7 +341,7 @@ static hsr_status read_ppm(const char *path, int W, int H, uint16_t **out, char 
     for (size_t i = 0; i < 3 * (size_t)w * (size_t)h; i++) {
         int v = fgetc(f);
         if (bytes == 2 && v >= 0) { int lo = fgetc(f); v = lo < 0 ? -1 : (v << 8) | lo; }
-        if (v < 0) { free(img); free(src); fclose(f); if (err) snprintf(err, errlen, "%s: truncated", path); return HSR_EPARSE; }
+        if (v < 0) { free(img); free(src); fclose(f); if (err) snprintf(err, errlen, "%s: %s: truncated", where, path); return HSR_EPARSE; }
         src[i] = (uint16_t)lround((double)v * 4095.0 / maxv);
     }
     for (int y = 0; y < H; y++)

@@ -28,6 +28,7 @@ static const char USAGE[] =
     "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
     "                  [--capacity SLOTS] [--expect]\n"
     "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full]\n"
+    "       yproc read SCENE -o FILE.json\n"
     "\n"
     "hsr   exact hidden-surface removal of SCENE (docs/hsr.md)\n"
     "      --dump-llr F    the visible domains (LLR) as JSON     --dump-input F  the projected input faces\n"
@@ -42,6 +43,8 @@ static const char USAGE[] =
     "      --expect        also write the expected pixels\n"
     "anim  an animation (.anim) through the incremental pipeline, frame by frame\n"
     "      --full          re-render every frame in full (the baseline)\n"
+    "read  the scene and its OBJ/MTL files as read, as JSON (schema hsr-scene-1, docs/hsr.md):\n"
+    "      what the Python reference renderer draws, so every format has one reader\n"
     "\n"
     "Errors are printed as \"file:line: message\" with exit status 1; a bad command line exits 2.\n";
 
@@ -89,14 +92,30 @@ static hsr_status write_input_json(const char *path, const hsr_ctx *h, const hsr
     return st;
 }
 
+static int read_main(int argc, char **argv)
+{
+    if (argc != 5 || strcmp(argv[3], "-o"))
+        return yproc_usage_error(argc == 4 && !strcmp(argv[3], "-o") ? "missing value after '-o'"
+                                 : "expected: yproc read SCENE -o FILE.json", NULL);
+    char err[1024] = "";
+    hsr_scene *sc;
+    hsr_status st = hsr_scene_load(argv[2], &sc, err, sizeof err);
+    if (st != HSR_OK) { fprintf(stderr, "%s\n", err[0] ? err : hsr_status_str(st)); return 1; }
+    st = hsr_write_scene_json(argv[4], sc);
+    if (st != HSR_OK) fprintf(stderr, "%s: cannot write (%s)\n", argv[4], hsr_status_str(st));
+    hsr_scene_free(sc);
+    return st == HSR_OK ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
     for (int i = 1; i < argc; i++)
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { fputs(USAGE, stdout); return 0; }
-    if (argc < 2) return yproc_usage_error("missing subcommand (hsr, scan or anim)", NULL);
-    if (strcmp(argv[1], "hsr") && strcmp(argv[1], "scan") && strcmp(argv[1], "anim"))
+    if (argc < 2) return yproc_usage_error("missing subcommand (hsr, scan, anim or read)", NULL);
+    if (strcmp(argv[1], "hsr") && strcmp(argv[1], "scan") && strcmp(argv[1], "anim") && strcmp(argv[1], "read"))
         return yproc_usage_error("unknown subcommand", argv[1]);
     if (argc < 3) return yproc_usage_error("missing scene file after", argv[1]);
+    if (!strcmp(argv[1], "read")) return read_main(argc, argv);
     if (strcmp(argv[1], "hsr")) return yproc_scan_main(argc, argv);
     const char *scene = argv[2], *json = NULL, *svg = NULL, *input = NULL, *ops = NULL;
     int stats = 0, rebuild = 0;
