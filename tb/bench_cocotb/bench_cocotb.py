@@ -1,5 +1,5 @@
 """cocotb overhead benchmark (not a test: the file name keeps it out of `make test`;
-scripts/bench_array.py runs it explicitly). Drives a random stream into de_array, one
+diffengine bench array runs it explicitly). Drives a random stream into de_array, one
 instruction per clock, with no checking, and prints the simulated cycles per second."""
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import RisingEdge
 
-from diffengine import isa, randgen
+from diffengine import isa
+from diffengine.regress import randgen
 
 
 @cocotb.test()

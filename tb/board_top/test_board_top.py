@@ -49,7 +49,10 @@ sys.path.insert(0, str(HERE.parent.parent / "fpga" / "ulx3s"))
 import tmds  # noqa: E402
 # The host tool's command encoders: the test checks them against the RTL too.
 from de32_load import cmd_p, cmd_w, with_chk  # noqa: E402
-from diffengine import binfmt, functional, isa, randgen  # noqa: E402
+from diffengine.formats import binfmt  # noqa: E402
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
 
 NCH = 3
 

@@ -21,8 +21,10 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from diffengine import functional, isa, randgen
-from diffengine import structural as st
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
+from diffengine.model import structural as st
 
 NUM_PE = 9
 FAULTY = (3, 10)  # PEs garbled by the FaultMask build (bypass test)
@@ -251,7 +253,7 @@ async def table_7_5_through_the_mapper(dut):
     (binfmt.map_word, against which rtl/proto/de_data_mapper.sv is tested), with
     compensation when the array has the fault. Registers B (dI) and A (I) of PEs 0..8
     match the source's correct or compensated columns digit for digit."""
-    from diffengine import binfmt
+    from diffengine.formats import binfmt
     arr = await start(dut)
     bug = carry_bug(dut)
     cmd = isa.Command("EVAL", 0, 9, (0, 0, 1 << 23))  # ddI = 0x000.800000

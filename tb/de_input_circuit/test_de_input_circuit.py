@@ -1,4 +1,4 @@
-"""The prototype input circuit against the golden model (diffengine.binfmt.map_word).
+"""The prototype input circuit against the golden model (diffengine.formats.binfmt.map_word).
 
 driver: random frame-store words (every LUT code, random operands, windows 0..4,
 compensation on/off) one per clock -> monitor: mapper output one clock later, the
@@ -13,7 +13,7 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from diffengine.binfmt import map_word
+from diffengine.formats.binfmt import map_word
 
 N_WORDS = 4000
 

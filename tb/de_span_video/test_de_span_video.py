@@ -21,7 +21,9 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 
-from diffengine import functional, isa, randgen
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
 
 PIX_PS = 40000
 

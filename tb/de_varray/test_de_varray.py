@@ -5,7 +5,7 @@ slot rate) and the plain de_array run side by side on one stream (tb_de_varray.s
 every step the virtual array's pixel and bus outputs must equal the plain array's (bus
 outputs as a sequence, pixels as raster-order lines with no gap), and the frames must
 equal the golden model (functional.render) bit for bit. Streams: random
-(sw/diffengine/randgen.py, seed printed, SEED=<n> replays), directed fold-boundary
+(sw/diffengine/regress/randgen.py, seed printed, SEED=<n> replays), directed fold-boundary
 spans, and the seed's Fig. 7.21 / 7.25 command lists. With and without the carry bug.
 """
 from __future__ import annotations
@@ -20,7 +20,10 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 
-from diffengine import asm, functional, isa, randgen
+from diffengine.formats import asm
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
 
 SCENES = Path(__file__).resolve().parents[2] / "sw" / "scenes"
 

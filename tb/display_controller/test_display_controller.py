@@ -41,7 +41,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE.parent.parent / "sw"))
 
-from diffengine import functional, isa, randgen  # noqa: E402
+from diffengine.model import functional  # noqa: E402
+from diffengine import isa
+from diffengine.regress import randgen
 
 NCH = 3
 REFRESH_ID = 0x100

@@ -41,7 +41,9 @@ RTL = REPO / "rtl"
 
 
 def stream(n: int):
-    from diffengine import asm, isa, randgen
+    from diffengine.formats import asm
+    from diffengine import isa
+    from diffengine.regress import randgen
     from de_array.test_de_array import spaced
     seed = int(os.environ.get("SEED", random.randrange(1 << 31)))
     cocotb.log.info(f"SEED={seed} (replay with SEED={seed})")
@@ -54,7 +56,7 @@ def stream(n: int):
 @cocotb.test()
 async def netlist_frames(dut):
     """Play the stream into the netlist; the pixels form the golden model's frame."""
-    from diffengine import functional
+    from diffengine.model import functional
     fold = int(os.environ.get("DE_FOLD", "0"))   # 0: plain array (one slot per clock)
     bug = bool(int(os.environ.get("DE_CARRY_BUG", "0")))
     cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
@@ -91,7 +93,9 @@ async def span_netlist_frames(dut):
     """The span-serial array's netlist: a random stream and the figure lists (the
     columns that fit) through the valid/ready port equal the golden model."""
     from de_span_array.test_de_span_array import start
-    from diffengine import asm, isa, randgen
+    from diffengine.formats import asm
+    from diffengine import isa
+    from diffengine.regress import randgen
     n = int(os.environ["DE_SPAN_COLS"])
     seed = int(os.environ.get("SEED", random.randrange(1 << 31)))
     dut._log.info(f"SEED={seed} (replay with SEED={seed})")
