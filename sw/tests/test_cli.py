@@ -249,3 +249,18 @@ def test_compare_reports_outliers_and_fails_the_gate(tmp_path, capsys):
     assert rc == 0
     rc, _, err = run(capsys, "compare", tmp_path / "bad.png", tmp_path / "nope.png")
     assert rc == commands.EXIT_INPUT and "nope.png" in err
+
+
+def test_reference_and_frame_bad_input_name_the_file_without_traceback(tmp_path, capsys):
+    """The subcommands that were module mains (`python -m diffengine.reference/.frame`)
+    report a bad file as `file[:line]: message` with exit 1, as the others do."""
+    scene = tmp_path / "bad.scene"
+    scene.write_text("camera 0 0 0\n")
+    rc, _, err = run(capsys, "reference", scene, "-o", tmp_path / "x.png")
+    assert rc == 1 and f"{scene}:1:" in err and "Traceback" not in err
+    dcf = tmp_path / "bad.dcf"
+    dcf.write_bytes(b"nope")
+    rc, _, err = run(capsys, "frame", dcf, tmp_path / "x.png")
+    assert rc == 1 and f"{dcf}: not a DCF1 frame file" in err
+    rc, _, err = run(capsys, "frame", tmp_path / "missing.dcf", tmp_path / "x.png")
+    assert rc == 1 and "missing.dcf: No such file" in err

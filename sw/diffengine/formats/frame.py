@@ -119,8 +119,16 @@ def configure(ap) -> None:
 
 def command(a) -> int:
     from ..rtl.dc_harness import read_dcf
-    frames = read_dcf(a.input)
-    f = frames[a.frame]
+    try:
+        frames = read_dcf(a.input)
+        f = frames[a.frame]
+    except OSError as e:
+        print(f"diffengine frame: {a.input}: {e.strerror or e}", file=sys.stderr)
+        return 1
+    except (ValueError, IndexError) as e:   # not a .dcf (the message names it), no such frame
+        print(f"diffengine frame: {e}" if isinstance(e, ValueError)
+              else f"diffengine frame: {a.input}: {e}", file=sys.stderr)
+        return 1
     write_png16(a.output, f)
     if a.view8:
         write_png8(a.view8, f)

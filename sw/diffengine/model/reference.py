@@ -474,9 +474,13 @@ def configure(ap) -> None:
 def command(a) -> int:
     import time
     t0 = time.monotonic()
-    img = render_file(a.scene, a.samples,
-                      progress=lambda d, n: print(f"\rreference: {d}/{n} rows", end="",
-                                                  file=sys.stderr))
+    try:
+        img = render_file(a.scene, a.samples,
+                          progress=lambda d, n: print(f"\rreference: {d}/{n} rows", end="",
+                                                      file=sys.stderr))
+    except SceneError as e:   # file:line: message, no traceback
+        print(f"diffengine reference: {e}", file=sys.stderr)
+        return 1
     print(f"\nreference: {time.monotonic() - t0:.1f} s", file=sys.stderr)
     if a.output.endswith(".npy"):
         np.save(a.output, img)
