@@ -38,9 +38,6 @@ for f in rtl/board/*.sv; do
     *) lint_top "$(basename "$f" .sv)" "$f" ;;
   esac
 done
-# virtual array: de_vpe.sv is generated from de_pe.sv (rtl/varray/gen_vpe.py)
-python3 rtl/varray/gen_vpe.py build/varray/de_vpe.sv >/dev/null
-lint_top de_varray $pkg build/varray/de_vpe.sv rtl/varray/de_varray.sv
 lint_top de_span_array $pkg rtl/varray/de_span_array.sv
 lint_top de_span_video $pkg rtl/varray/de_span_array.sv rtl/varray/de_afifo.sv rtl/varray/de_skid.sv \
   rtl/varray/de_span_video.sv

@@ -9,7 +9,6 @@ Not in `make test` (a fresh run synthesises: ~1.5 min of yosys per netlist): run
 
 Netlists (built once into tb/postsynth/sim_build_net_*/, redone when a source changes):
   de_array  NumChips=1 (9 columns)          yosys `synth -flatten` (generic gates)
-  de_varray NumChips=1 Fold=3 (3 phys PEs)  yosys `synth -flatten` (generic gates)
   de_span_array NumCols=37 MaxSlots=2       yosys `synth -flatten` (generic gates; the
                                             state banks and pass table stay memories:
                                             the ECP5 DP16KD model is a black box)
@@ -177,16 +176,6 @@ TIER = pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH", "0")),
 def test_postsynth_array():
     net = netlist("de_array", {"NumChips": 1}, [RTL / s for s in ARRAY_SRCS], "array1")
     run("de_array", [net], "array1", {"DE_FOLD": "0"})
-
-
-@TIER
-def test_postsynth_varray():
-    sys.path.insert(0, str(RTL / "varray"))
-    from gen_vpe import ensure
-    vpe = ensure(HERE / "sim_build_gen" / "de_vpe.sv")
-    srcs = [RTL / "xproc" / "de_pkg.sv", vpe, RTL / "varray" / "de_varray.sv"]
-    net = netlist("de_varray", {"NumChips": 1, "Fold": 3}, srcs, "varray1_f3")
-    run("de_varray", [net], "varray1_f3", {"DE_FOLD": "3"})
 
 
 @TIER
