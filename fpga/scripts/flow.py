@@ -33,11 +33,16 @@ FPGA = Path(__file__).resolve().parents[1]
 ROOT = FPGA.parent
 BUILD = FPGA / "build"
 REPORTS = FPGA / "reports"
-RTL_CHIP = ["rtl/xproc/de_pkg.sv", "rtl/xproc/de_pe.sv", "rtl/array/de_chip.sv"]
-RTL_ARRAY = RTL_CHIP + ["rtl/proto/de_skew.sv", "rtl/proto/de_deskew.sv",
-                        "rtl/array/de_array.sv"]
+sys.path.insert(0, str(ROOT / "scripts"))
+import filelist  # noqa: E402  the FuseSoC cores' file lists (scripts/filelist.py)
 PIXEL_CLOCK_640 = 25.175   # MHz, 640x480@60 (VESA/VGA)
 FORCE = bool(int(__import__("os").environ.get("FORCE", "0") or 0))
+
+
+def core_srcs(core: str, target: str = "default") -> list[str]:
+    """The files of a FuseSoC core/target, relative to the checkout (rtl/*/*.core,
+    fpga/de_fpga.core): the synthesis scripts get exactly the cores' lists."""
+    return filelist.describe(core, target)["files"]
 
 # Devices. ECP5: LFE5U-85F, the largest ECP5 (the brief's target).
 ECP5 = {"args": ["--85k", "--package", "CABGA381", "--speed", "6"],
@@ -173,18 +178,19 @@ def nobypass_chip(out: Path) -> Path:
 def chip(args) -> int:
     fam = args.family
     tmpl = f"chip_{fam}.ys"
-    top_sv = FPGA / "chip_top.sv"
     runs = {}
     variants = [("pe9", 9, False), ("pe1", 1, False), ("pe9_nobypass", 9, True)]
     for tag, npe, nobyp in variants:
         out = BUILD / f"chip_{fam}" / tag
         print(f"[{fam} {tag}] synthesis", flush=True)
-        srcs = RTL_CHIP if not nobyp else RTL_CHIP[:2]
-        extra = [nobypass_chip(out)] if nobyp else []
-        # chip_top (for place and route) and the bare de_chip (for the resource count).
-        cells_top = yosys(tmpl, out, "chip_top", srcs, {"NumPe": npe}, extra + [top_sv])
+        # chip_top (for place and route) and the bare de_chip (for the resource count);
+        # the what-if variant reads its copy of de_chip.sv in place of the original.
+        swap = {"rtl/array/de_chip.sv": str(nobypass_chip(out))} if nobyp else {}
+        srcs_top = [swap.get(s, s) for s in core_srcs("fpga", "chip")]
+        srcs = [swap.get(s, s) for s in core_srcs("chip")]
+        cells_top = yosys(tmpl, out, "chip_top", srcs_top, {"NumPe": npe})
         bare = out / "bare"
-        cells_chip = yosys(tmpl, bare, "de_chip", srcs, {"NumPe": npe}, extra)
+        cells_chip = yosys(tmpl, bare, "de_chip", srcs, {"NumPe": npe})
         r = {"num_pe": npe, "bypass_muxes": not nobyp, "cells_de_chip": cells_chip,
              "cells_chip_top": cells_top}
         # The 9-PE chip picks the smallest device that fits; the other variants use the
@@ -314,7 +320,8 @@ def array_fit(args) -> int:
     for n in sorted(int(x) for x in args.chips.split(",") if x):
         out = BUILD / "array_ecp5" / f"flat_{n}"
         print(f"[array {n} chips = {9 * n} PEs] synthesis", flush=True)
-        cells = yosys("array_ecp5.ys", out, "de_array", RTL_ARRAY, {"NumChips": n})
+        cells = yosys("array_ecp5.ys", out, "de_array", core_srcs("array", "synth"),
+                      {"NumChips": n})
         flat[n] = {"cells": {k: count(cells, k) for k in keys}, "seconds": synth_seconds(out)}
     # Least-squares line cells = a + b * chips over the flat runs.
     fit = {}

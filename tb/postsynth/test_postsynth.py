@@ -36,7 +36,6 @@ from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 SCENES = REPO / "sw" / "scenes"
-RTL = REPO / "rtl"
 
 
 def stream(n: int):
@@ -105,8 +104,6 @@ async def span_netlist_frames(dut):
 
 
 # ---- netlists and runners ----------------------------------------------------------------
-ARRAY_SRCS = ["xproc/de_pkg.sv", "xproc/de_pe.sv", "proto/de_skew.sv", "proto/de_deskew.sv",
-              "array/de_chip.sv", "array/de_array.sv"]
 
 
 def netlist(top: str, params: dict, srcs: list[Path], tag: str, ecp5: bool = False) -> Path:
@@ -174,13 +171,15 @@ TIER = pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH", "0")),
 
 @TIER
 def test_postsynth_array():
-    net = netlist("de_array", {"NumChips": 1}, [RTL / s for s in ARRAY_SRCS], "array1")
+    from common.run import rtl_files
+    net = netlist("de_array", {"NumChips": 1}, rtl_files("array"), "array1")
     run("de_array", [net], "array1", {"DE_FOLD": "0"})
 
 
 @TIER
 def test_postsynth_span():
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "varray" / "de_span_array.sv"]
+    from common.run import rtl_files
+    srcs = rtl_files("span_array", "sim")
     net = netlist("de_span_array", {"NumCols": 37, "MaxSlots": 2}, srcs, "span37_s2")
     run("de_span_array", [net], "span37_s2", {"DE_SPAN_COLS": "37"},
         testcase="span_netlist_frames")
@@ -190,6 +189,7 @@ def test_postsynth_span():
                     reason="tier: make -C fpga postsynth-ecp5 (DE_POSTSYNTH_ECP5=1)")
 def test_postsynth_array_ecp5_cells():
     cells = ecp5_cell_models()
-    net = netlist("de_array", {"NumChips": 1}, [RTL / s for s in ARRAY_SRCS], "array1_ecp5",
+    from common.run import rtl_files
+    net = netlist("de_array", {"NumChips": 1}, rtl_files("array"), "array1_ecp5",
                   ecp5=True)
     run("de_array", [cells, net], "array1_ecp5", {"DE_FOLD": "0"}, simulator="icarus")
