@@ -32,9 +32,13 @@ CORE_DIRS = ("rtl", "sim/fast", "fpga", "tb")
 HDL_TYPES = ("systemVerilogSource", "verilogSource")
 
 
+# The same patterns as scripts/cores.mk's CORE_DEFS (make's dependencies).
+CORE_GLOBS = ("rtl/*/*.core", "sim/fast/*.core", "fpga/*.core", "tb/*/*.core")
+
+
 def core_files() -> list[Path]:
     """Every .core file of the project, sorted."""
-    return sorted(p for d in CORE_DIRS for p in (ROOT / d).rglob("*.core"))
+    return sorted(p for g in CORE_GLOBS for p in ROOT.glob(g))
 
 
 def vlnv(core: str) -> str:
