@@ -39,7 +39,7 @@ help:
 	@echo "make lint        verilator -Wall and verible lint on every RTL file"
 	@echo "make fpga        yosys + nextpnr: 9-PE chip on ECP5 and iCE40, 640-PE fit, span-serial"
 	@echo "                 array (3 x 648 columns), ULX3S board bitstream (fpga/, docs/fpga.md,"
-	@echo "                 docs/board.md); the folded virtual array: make -C fpga varray"
+	@echo "                 docs/board.md)"
 	@echo "make fpga-board  only the ULX3S bitstream (fpga/ulx3s)"
 	@echo "make postsynth   yosys netlists simulated in Icarus against the golden model"
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"

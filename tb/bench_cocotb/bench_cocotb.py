@@ -43,11 +43,9 @@ async def drive_stream(dut):
 
 
 def test_bench_cocotb():
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
-            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
-            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv"]
+    srcs = rtl_files("array", "sim")
     build_and_test(here, "de_array", srcs, "bench_cocotb",
                    parameters={"NumChips": int(os.environ.get("BENCH_CHIPS", 1)),
                                "CarryBug": 0},

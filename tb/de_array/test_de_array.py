@@ -302,11 +302,9 @@ RUNS = [  # (chips, carry_bug, faulty)
 @pytest.mark.parametrize("chips,bug,faulty", RUNS,
                          ids=[f"chips{c}_bug{b}_faulty{f}" for c, b, f in RUNS])
 def test_de_array(chips, bug, faulty):
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
-            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
-            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv"]
+    srcs = rtl_files("array", "sim")
     mask = sum(1 << q for q in FAULTY) if faulty else 0
     params = {"NumChips": chips, "CarryBug": bug}
     if faulty:

@@ -400,8 +400,8 @@ async def table_7_5(dut):
 # ---- pytest runner --------------------------------------------------------------------------
 
 def _sources() -> list[Path]:
-    return [ROOT / "rtl/xproc/de_pkg.sv", ROOT / "rtl/xproc/de_pe.sv",
-            TB_DIR / "de_pe_chain.sv"]
+    from common.run import rtl_files   # tb/de_pe/de_pe_tb.core
+    return rtl_files("diffengine:tb:de_pe")
 
 
 def _run(carry_bug: int, n_pe: int = 9) -> None:

@@ -343,10 +343,9 @@ if os.environ.get("DE_SPAN_STREAM"):   # diffengine bench span: one full-width b
 @pytest.mark.parametrize("cols,slots,bug", RUNS,
                          ids=[f"cols{c}_slots{s}_bug{b}" for c, s, b in RUNS])
 def test_de_span_array(cols, slots, bug):
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    build_and_test(here, "de_span_array",
-                   [RTL / "xproc" / "de_pkg.sv", RTL / "varray" / "de_span_array.sv"],
+    build_and_test(here, "de_span_array", rtl_files("span_array", "sim"),
                    "test_de_span_array",
                    parameters={"NumCols": cols, "MaxSlots": slots, "CarryBug": bug},
                    extra_env={"DE_CARRY_BUG": str(bug)},
