@@ -109,16 +109,28 @@ module de_sdram_ctrl #(
   end
 
   // "since" counters saturate at 255 and read as "long ago"; a command in the clock
-  // after another is 1 clock after it, so gap >= N is since_q >= N - 1.
+  // after another is 1 clock after it, so a gap of at least N clocks is since_q >= N - 1
+  // (the M* thresholds).
   localparam int unsigned SW = 8;
   typedef logic [SW-1:0] since_t;
+  localparam since_t MRcd   = since_t'(NRcd - 1);
+  localparam since_t MRp    = since_t'(NRp - 1);
+  localparam since_t MRas   = since_t'(NRas - 1);
+  localparam since_t MRc    = since_t'(NRc - 1);
+  localparam since_t MRrd   = since_t'(NRrd - 1);
+  localparam since_t MRfc   = since_t'(NRfc - 1);
+  localparam since_t MWr    = since_t'(NWr - 1);
+  localparam since_t MMrd   = since_t'(NMrd - 1);
+  localparam since_t MBl    = since_t'(NBl - 1);
+  localparam since_t MRdWr  = since_t'(CasLatency + NBl - 1);
 
-  function automatic logic ok(since_t since, int unsigned n);
-    return 32'(since) + 1 >= n;
-  endfunction
+  if (NRc > 200 || NRfc > 200 || NRas > 200 || NRcd < 1 || NRp < 1 || NWr < 1 ||
+      NMrd < 1) begin : g_err_since
+    $error("de_sdram_ctrl: a timing is out of the 8-bit counters' range (1..200 clocks)");
+  end
 
-  function automatic since_t inc(since_t s);
-    return (s == '1) ? s : s + 1'b1;
+  function automatic logic [SW-1:0] inc(logic [SW-1:0] v);
+    return (v == {SW{1'b1}}) ? v : v + 1'b1;
   endfunction
 
   // {cs_n, ras_n, cas_n, we_n}
@@ -198,23 +210,23 @@ module de_sdram_ctrl #(
   always_comb begin
     hit       = open_q[cur_bank] && (row_q[cur_bank] == cur_row);
     miss_open = open_q[cur_bank] && !hit;
-    can_act   = ok(s_pre_q[cur_bank], NRp) && ok(s_act_q[cur_bank], NRc) &&
-                ok(s_act_any_q, NRrd) && ok(s_ref_q, NRfc) && ok(s_mrs_q, NMrd);
+    can_act   = (s_pre_q[cur_bank] >= MRp) && (s_act_q[cur_bank] >= MRc) &&
+                (s_act_any_q >= MRrd) && (s_ref_q >= MRfc) && (s_mrs_q >= MMrd);
     // A PRECHARGE ends the bank's read data CasLatency-1 clocks later: not before the
     // 8 beats of its last READ are out.
-    can_pre   = ok(s_act_q[cur_bank], NRas) && ok(s_wr_q[cur_bank], NWr) &&
-                ok(s_rd_q[cur_bank], NBl);
-    can_read  = hit && ok(s_act_q[cur_bank], NRcd) && ok(s_read_q, NBl);
+    can_pre   = (s_act_q[cur_bank] >= MRas) && (s_wr_q[cur_bank] >= MWr) &&
+                (s_rd_q[cur_bank] >= MBl);
+    can_read  = hit && (s_act_q[cur_bank] >= MRcd) && (s_read_q >= MBl);
     // The write data must not meet read data on DQ: the last READ's beats are on the
     // bus until CasLatency + 7 clocks after it.
-    can_write = hit && ok(s_act_q[cur_bank], NRcd) && ok(s_read_q, CasLatency + NBl);
+    can_write = hit && (s_act_q[cur_bank] >= MRcd) && (s_read_q >= MRdWr);
     all_pre_ok    = 1'b1;
     all_closed_ok = 1'b1;
     for (int unsigned b = 0; b < NBanks; b++) begin
-      if (open_q[b] && !(ok(s_act_q[b], NRas) && ok(s_wr_q[b], NWr) && ok(s_rd_q[b], NBl))) begin
+      if (open_q[b] && !((s_act_q[b] >= MRas) && (s_wr_q[b] >= MWr) && (s_rd_q[b] >= MBl))) begin
         all_pre_ok = 1'b0;
       end
-      if (!ok(s_pre_q[b], NRp)) all_closed_ok = 1'b0;
+      if (s_pre_q[b] < MRp) all_closed_ok = 1'b0;
     end
   end
 
@@ -262,7 +274,7 @@ module de_sdram_ctrl #(
         state_d = SInitRef;
       end
       SInitRef: begin
-        if (all_closed_ok && ok(s_ref_q, NRfc)) begin
+        if (all_closed_ok && (s_ref_q >= MRfc)) begin
           cmd_d      = CmdRef;
           s_ref_d    = '0;
           init_ref_d = 1'b1;
@@ -270,7 +282,7 @@ module de_sdram_ctrl #(
         end
       end
       SInitLmr: begin
-        if (ok(s_ref_q, NRfc)) begin
+        if (s_ref_q >= MRfc) begin
           cmd_d   = CmdLmr;
           ba_d    = '0;
           a_d     = ModeWord;
@@ -356,7 +368,7 @@ module de_sdram_ctrl #(
         end
       end
       SRef: begin
-        if (all_closed_ok && ok(s_ref_q, NRfc)) begin
+        if (all_closed_ok && (s_ref_q >= MRfc)) begin
           cmd_d     = CmdRef;
           s_ref_d   = '0;
           ref_cnt_d = '0;
@@ -376,8 +388,10 @@ module de_sdram_ctrl #(
       // Beat i is on DQ at the SDRAM's edge READ + CasLatency + i, one clock after this
       // register sends the READ: pipe position CasLatency + i.
       for (int unsigned i = 0; i < NBl; i++) begin
-        pipe_d[CasLatency + i] = '{valid: 1'b1, odd: i[0], last: (i == NBl - 1),
-                                   tag: cur_tag_q};
+        pipe_d[CasLatency + i].valid = 1'b1;
+        pipe_d[CasLatency + i].odd   = i[0];
+        pipe_d[CasLatency + i].last  = (i == NBl - 1);
+        pipe_d[CasLatency + i].tag   = cur_tag_q;
       end
     end
     low_d = low_q;
