@@ -108,29 +108,28 @@ module de_sdram_ctrl #(
     $error("de_sdram_ctrl: tREFI / tInit out of the counters' range");
   end
 
-  // "since" counters saturate at 255 and read as "long ago"; a command in the clock
-  // after another is 1 clock after it, so a gap of at least N clocks is since_q >= N - 1
-  // (the M* thresholds).
+  // "since" counters count clocks since a command and saturate at 255 ("long ago"). A
+  // command in the clock after another is 1 clock after it, so "a gap of at least N
+  // clocks" is since_q >= N - 1. For 125 MHz that test is registered: the flag f_*_q
+  // says it for this clock, computed in the clock before from the counter and from
+  // whether the command restarts it now (ge_next), so no comparator sits between the
+  // command decision and the pins.
   localparam int unsigned SW = 8;
   typedef logic [SW-1:0] since_t;
-  localparam since_t MRcd   = since_t'(NRcd - 1);
-  localparam since_t MRp    = since_t'(NRp - 1);
-  localparam since_t MRas   = since_t'(NRas - 1);
-  localparam since_t MRc    = since_t'(NRc - 1);
-  localparam since_t MRrd   = since_t'(NRrd - 1);
-  localparam since_t MRfc   = since_t'(NRfc - 1);
-  localparam since_t MWr    = since_t'(NWr - 1);
-  localparam since_t MMrd   = since_t'(NMrd - 1);
-  localparam since_t MBl    = since_t'(NBl - 1);
-  localparam since_t MRdWr  = since_t'(CasLatency + NBl - 1);
 
   if (NRc > 200 || NRfc > 200 || NRas > 200 || NRcd < 1 || NRp < 1 || NWr < 1 ||
       NMrd < 1) begin : g_err_since
     $error("de_sdram_ctrl: a timing is out of the 8-bit counters' range (1..200 clocks)");
   end
 
-  function automatic logic [SW-1:0] inc(logic [SW-1:0] v);
+  function automatic since_t inc(since_t v);
     return (v == {SW{1'b1}}) ? v : v + 1'b1;
+  endfunction
+
+  // Next clock's "gap >= n": restarted now -> since 0 >= n - 1; else inc(v) >= n - 1.
+  function automatic logic ge_next(since_t v, logic restart, int unsigned n);
+    if (restart) return n <= 1;
+    return (n <= 2) || (32'(v) >= n - 2);
   endfunction
 
   // {cs_n, ras_n, cas_n, we_n}
@@ -162,11 +161,21 @@ module de_sdram_ctrl #(
   logic [19:0] wait_d, wait_q;
   logic        init_ref_d, init_ref_q;     // the first init REF has gone
   logic [15:0] ref_cnt_d, ref_cnt_q;
+  logic        ref_due_d, ref_due_q;       // ref_cnt_q >= NRefi
 
   logic [NBanks-1:0]              open_d, open_q;
   logic [NBanks-1:0][RowBits-1:0] row_d, row_q;
   since_t [NBanks-1:0] s_act_d, s_act_q, s_pre_d, s_pre_q, s_rd_d, s_rd_q, s_wr_d, s_wr_q;
   since_t s_act_any_d, s_act_any_q, s_read_d, s_read_q, s_ref_d, s_ref_q, s_mrs_d, s_mrs_q;
+  // Restart strobes of the counters (this clock's command).
+  logic [NBanks-1:0] r_act, r_pre, r_rd, r_wr;
+  logic              r_act_any, r_read, r_ref, r_mrs, r_refcnt;
+  // Registered gap flags: per bank tRCD, tRP, tRC, tRAS, tWR, own burst out; device tRRD,
+  // tRFC, tMRD, READ-to-READ (8 beats), READ-to-WRITE (bus free).
+  logic [NBanks-1:0] f_rcd_d, f_rcd_q, f_rp_d, f_rp_q, f_rc_d, f_rc_q, f_ras_d, f_ras_q;
+  logic [NBanks-1:0] f_wr_d, f_wr_q, f_rdb_d, f_rdb_q;
+  logic              f_rrd_d, f_rrd_q, f_rfc_d, f_rfc_q, f_mrd_d, f_mrd_q;
+  logic              f_bl_d, f_bl_q, f_rdwr_d, f_rdwr_q;
 
   // The request being served.
   logic                cur_valid_d, cur_valid_q;
@@ -175,6 +184,9 @@ module de_sdram_ctrl #(
   logic [AW-1:0]       cur_addr_d, cur_addr_q;
   logic [31:0]         cur_data_d, cur_data_q;
   logic [TagW-1:0]     cur_tag_d, cur_tag_q;
+  logic                cur_open_d, cur_open_q;       // its bank has a row open
+  logic                cur_hit_d, cur_hit_q;         // ... and it is the request's row
+  logic [TagW-1:0]     iss_tag_d, iss_tag_q;         // tag of the READ on the pins
 
   // Pins.
   logic [3:0]          cmd_d, cmd_q;
@@ -200,7 +212,7 @@ module de_sdram_ctrl #(
   assign cur_colw = cur_addr_q[ColBits-2:0];
 
   logic accept;
-  assign accept         = (state_q == SRun) && !cur_valid_q && (ref_cnt_q < 16'(NRefi));
+  assign accept         = (state_q == SRun) && !cur_valid_q && !ref_due_q;
   assign rd_req_ready_o = accept;
   assign wr_ready_o     = accept && !rd_req_valid_i;
 
@@ -208,53 +220,45 @@ module de_sdram_ctrl #(
   logic hit, miss_open, can_act, can_pre, can_read, can_write, all_pre_ok, all_closed_ok;
 
   always_comb begin
-    hit       = open_q[cur_bank] && (row_q[cur_bank] == cur_row);
-    miss_open = open_q[cur_bank] && !hit;
-    can_act   = (s_pre_q[cur_bank] >= MRp) && (s_act_q[cur_bank] >= MRc) &&
-                (s_act_any_q >= MRrd) && (s_ref_q >= MRfc) && (s_mrs_q >= MMrd);
+    hit       = cur_hit_q;
+    miss_open = cur_open_q && !cur_hit_q;
+    can_act   = f_rp_q[cur_bank] && f_rc_q[cur_bank] && f_rrd_q && f_rfc_q && f_mrd_q;
     // A PRECHARGE ends the bank's read data CasLatency-1 clocks later: not before the
-    // 8 beats of its last READ are out.
-    can_pre   = (s_act_q[cur_bank] >= MRas) && (s_wr_q[cur_bank] >= MWr) &&
-                (s_rd_q[cur_bank] >= MBl);
-    can_read  = hit && (s_act_q[cur_bank] >= MRcd) && (s_read_q >= MBl);
+    // 8 beats of its last READ are out (f_rdb).
+    can_pre   = f_ras_q[cur_bank] && f_wr_q[cur_bank] && f_rdb_q[cur_bank];
+    can_read  = hit && f_rcd_q[cur_bank] && f_bl_q;
     // The write data must not meet read data on DQ: the last READ's beats are on the
-    // bus until CasLatency + 7 clocks after it.
-    can_write = hit && (s_act_q[cur_bank] >= MRcd) && (s_read_q >= MRdWr);
-    all_pre_ok    = 1'b1;
-    all_closed_ok = 1'b1;
-    for (int unsigned b = 0; b < NBanks; b++) begin
-      if (open_q[b] && !((s_act_q[b] >= MRas) && (s_wr_q[b] >= MWr) && (s_rd_q[b] >= MBl))) begin
-        all_pre_ok = 1'b0;
-      end
-      if (s_pre_q[b] < MRp) all_closed_ok = 1'b0;
-    end
+    // bus until CasLatency + 7 clocks after it (f_rdwr).
+    can_write = hit && f_rcd_q[cur_bank] && f_rdwr_q;
+    all_pre_ok    = &(~open_q | (f_ras_q & f_wr_q & f_rdb_q));
+    all_closed_ok = &f_rp_q;
   end
 
   always_comb begin
     state_d     = state_q;
     wait_d      = (wait_q != '0) ? wait_q - 1'b1 : wait_q;
     init_ref_d  = init_ref_q;
-    ref_cnt_d   = (state_q == SInitWait || state_q == SInitPre || state_q == SInitRef ||
-                   state_q == SInitLmr) ? '0 :
-                  ((ref_cnt_q == '1) ? ref_cnt_q : ref_cnt_q + 1'b1);
+    r_refcnt    = (state_q == SInitWait || state_q == SInitPre || state_q == SInitRef ||
+                   state_q == SInitLmr);
     open_d      = open_q;
     row_d       = row_q;
-    s_act_any_d = inc(s_act_any_q);
-    s_read_d    = inc(s_read_q);
-    s_ref_d     = inc(s_ref_q);
-    s_mrs_d     = inc(s_mrs_q);
-    for (int unsigned b = 0; b < NBanks; b++) begin
-      s_act_d[b] = inc(s_act_q[b]);
-      s_pre_d[b] = inc(s_pre_q[b]);
-      s_rd_d[b]  = inc(s_rd_q[b]);
-      s_wr_d[b]  = inc(s_wr_q[b]);
-    end
+    r_act       = '0;
+    r_pre       = '0;
+    r_rd        = '0;
+    r_wr        = '0;
+    r_act_any   = 1'b0;
+    r_read      = 1'b0;
+    r_ref       = 1'b0;
+    r_mrs       = 1'b0;
     cur_valid_d = cur_valid_q;
     cur_write_d = cur_write_q;
     cur_beat_d  = cur_beat_q;
     cur_addr_d  = cur_addr_q;
     cur_data_d  = cur_data_q;
     cur_tag_d   = cur_tag_q;
+    cur_open_d  = cur_open_q;
+    cur_hit_d   = cur_hit_q;
+    iss_tag_d   = iss_tag_q;
     cmd_d       = CmdNop;
     ba_d        = ba_q;
     a_d         = a_q;
@@ -270,29 +274,29 @@ module de_sdram_ctrl #(
         cmd_d   = CmdPre;
         a_d     = '0;
         a_d[10] = 1'b1;                                    // all banks
-        for (int unsigned b = 0; b < NBanks; b++) s_pre_d[b] = '0;
+        r_pre   = '1;
         state_d = SInitRef;
       end
       SInitRef: begin
-        if (all_closed_ok && (s_ref_q >= MRfc)) begin
+        if (all_closed_ok && f_rfc_q) begin
           cmd_d      = CmdRef;
-          s_ref_d    = '0;
+          r_ref      = 1'b1;
           init_ref_d = 1'b1;
           if (init_ref_q) state_d = SInitLmr;
         end
       end
       SInitLmr: begin
-        if (s_ref_q >= MRfc) begin
+        if (f_rfc_q) begin
           cmd_d   = CmdLmr;
           ba_d    = '0;
           a_d     = ModeWord;
-          s_mrs_d = '0;
+          r_mrs   = 1'b1;
           state_d = SRun;
         end
       end
       SRun: begin
         if (!cur_valid_q) begin
-          if (ref_cnt_q >= 16'(NRefi)) begin
+          if (ref_due_q) begin
             state_d = SRefPre;
           end else if (rd_req_valid_i) begin
             cur_valid_d = 1'b1;
@@ -306,6 +310,11 @@ module de_sdram_ctrl #(
             cur_addr_d  = wr_addr_i;
             cur_data_d  = wr_data_i;
           end
+          // No command goes in this clock, so open_q / row_q are final: whether the new
+          // request's row is open is decided here, off the command path.
+          cur_open_d = open_q[cur_addr_d[AW-1 -: BankBits]];
+          cur_hit_d  = cur_open_d &&
+                       (row_q[cur_addr_d[AW-1 -: BankBits]] == cur_addr_d[ColBits-1 +: RowBits]);
         end else if (cur_write_q && cur_beat_q) begin
           // Second beat of a write: the high half, one column on, the next clock.
           cmd_d    = CmdWrite;
@@ -313,7 +322,7 @@ module de_sdram_ctrl #(
           a_d      = PinAW'({cur_colw, 1'b1});
           dq_d     = cur_data_q[31:16];
           dq_oe_d  = 1'b1;
-          s_wr_d[cur_bank] = '0;
+          r_wr[cur_bank] = 1'b1;
           cur_valid_d = 1'b0;
           cur_beat_d  = 1'b0;
         end else if (miss_open) begin
@@ -321,18 +330,21 @@ module de_sdram_ctrl #(
             cmd_d = CmdPre;
             ba_d  = cur_bank;
             a_d   = '0;                                    // A10 = 0: this bank only
-            open_d[cur_bank]  = 1'b0;
-            s_pre_d[cur_bank] = '0;
+            open_d[cur_bank] = 1'b0;
+            r_pre[cur_bank]  = 1'b1;
+            cur_open_d       = 1'b0;
           end
         end else if (!hit) begin
           if (can_act) begin
             cmd_d = CmdAct;
             ba_d  = cur_bank;
             a_d   = cur_row;
-            open_d[cur_bank]  = 1'b1;
-            row_d[cur_bank]   = cur_row;
-            s_act_d[cur_bank] = '0;
-            s_act_any_d       = '0;
+            open_d[cur_bank] = 1'b1;
+            row_d[cur_bank]  = cur_row;
+            r_act[cur_bank]  = 1'b1;
+            r_act_any        = 1'b1;
+            cur_open_d       = 1'b1;
+            cur_hit_d        = 1'b1;
           end
         end else if (cur_write_q) begin
           if (can_write) begin
@@ -341,15 +353,16 @@ module de_sdram_ctrl #(
             a_d     = PinAW'({cur_colw, 1'b0});
             dq_d    = cur_data_q[15:0];
             dq_oe_d = 1'b1;
-            s_wr_d[cur_bank] = '0;
+            r_wr[cur_bank] = 1'b1;
             cur_beat_d = 1'b1;
           end
         end else if (can_read) begin
           cmd_d = CmdRead;
           ba_d  = cur_bank;
           a_d   = PinAW'({cur_colw, 1'b0});
-          s_rd_d[cur_bank] = '0;
-          s_read_d    = '0;
+          r_rd[cur_bank] = 1'b1;
+          r_read      = 1'b1;
+          iss_tag_d   = cur_tag_q;
           cur_valid_d = 1'b0;
         end
       end
@@ -360,18 +373,16 @@ module de_sdram_ctrl #(
           cmd_d   = CmdPre;
           a_d     = '0;
           a_d[10] = 1'b1;
-          for (int unsigned b = 0; b < NBanks; b++) begin
-            if (open_q[b]) s_pre_d[b] = '0;
-          end
+          r_pre   = open_q;
           open_d  = '0;
           state_d = SRef;
         end
       end
       SRef: begin
-        if (all_closed_ok && (s_ref_q >= MRfc)) begin
+        if (all_closed_ok && f_rfc_q) begin
           cmd_d     = CmdRef;
-          s_ref_d   = '0;
-          ref_cnt_d = '0;
+          r_ref     = 1'b1;
+          r_refcnt  = 1'b1;
           refresh_o = 1'b1;
           state_d   = SRun;
         end
@@ -380,18 +391,46 @@ module de_sdram_ctrl #(
     endcase
   end
 
+  // ---------------------------------------------------------------- counters and flags
+  always_comb begin
+    ref_cnt_d   = r_refcnt ? '0 : ((ref_cnt_q == '1) ? ref_cnt_q : ref_cnt_q + 1'b1);
+    ref_due_d   = !r_refcnt && (ref_cnt_q >= 16'(NRefi - 1));
+    s_act_any_d = r_act_any ? '0 : inc(s_act_any_q);
+    s_read_d    = r_read ? '0 : inc(s_read_q);
+    s_ref_d     = r_ref ? '0 : inc(s_ref_q);
+    s_mrs_d     = r_mrs ? '0 : inc(s_mrs_q);
+    f_rrd_d     = ge_next(s_act_any_q, r_act_any, NRrd);
+    f_bl_d      = ge_next(s_read_q, r_read, NBl);
+    f_rdwr_d    = ge_next(s_read_q, r_read, CasLatency + NBl);
+    f_rfc_d     = ge_next(s_ref_q, r_ref, NRfc);
+    f_mrd_d     = ge_next(s_mrs_q, r_mrs, NMrd);
+    for (int unsigned b = 0; b < NBanks; b++) begin
+      s_act_d[b] = r_act[b] ? '0 : inc(s_act_q[b]);
+      s_pre_d[b] = r_pre[b] ? '0 : inc(s_pre_q[b]);
+      s_rd_d[b]  = r_rd[b] ? '0 : inc(s_rd_q[b]);
+      s_wr_d[b]  = r_wr[b] ? '0 : inc(s_wr_q[b]);
+      f_rcd_d[b] = ge_next(s_act_q[b], r_act[b], NRcd);
+      f_rc_d[b]  = ge_next(s_act_q[b], r_act[b], NRc);
+      f_ras_d[b] = ge_next(s_act_q[b], r_act[b], NRas);
+      f_rp_d[b]  = ge_next(s_pre_q[b], r_pre[b], NRp);
+      f_wr_d[b]  = ge_next(s_wr_q[b], r_wr[b], NWr);
+      f_rdb_d[b] = ge_next(s_rd_q[b], r_rd[b], NBl);
+    end
+  end
+
   // ---------------------------------------------------------------- read data
   always_comb begin
     pipe_d = '0;
     for (int unsigned j = 0; j + 1 < PipeL; j++) pipe_d[j] = pipe_q[j + 1];
-    if (cmd_d == CmdRead) begin
-      // Beat i is on DQ at the SDRAM's edge READ + CasLatency + i, one clock after this
-      // register sends the READ: pipe position CasLatency + i.
+    if (cmd_q == CmdRead) begin
+      // Beat i is on DQ at the SDRAM's edge READ + CasLatency + i; the READ is on the
+      // pins now (the SDRAM takes it at the next edge), so beat i is captured
+      // CasLatency + i clocks after that edge: pipe position CasLatency - 1 + i after it.
       for (int unsigned i = 0; i < NBl; i++) begin
-        pipe_d[CasLatency + i].valid = 1'b1;
-        pipe_d[CasLatency + i].odd   = i[0];
-        pipe_d[CasLatency + i].last  = (i == NBl - 1);
-        pipe_d[CasLatency + i].tag   = cur_tag_q;
+        pipe_d[CasLatency - 1 + i].valid = 1'b1;
+        pipe_d[CasLatency - 1 + i].odd   = i[0];
+        pipe_d[CasLatency - 1 + i].last  = (i == NBl - 1);
+        pipe_d[CasLatency - 1 + i].tag   = iss_tag_q;
       end
     end
     low_d = low_q;
@@ -418,6 +457,7 @@ module de_sdram_ctrl #(
       wait_q      <= 20'(NInit);
       init_ref_q  <= 1'b0;
       ref_cnt_q   <= '0;
+      ref_due_q   <= 1'b0;
       open_q      <= '0;
       row_q       <= '0;
       s_act_q     <= '1;
@@ -428,12 +468,26 @@ module de_sdram_ctrl #(
       s_read_q    <= '1;
       s_ref_q     <= '1;
       s_mrs_q     <= '1;
+      f_rcd_q     <= '1;
+      f_rp_q      <= '1;
+      f_rc_q      <= '1;
+      f_ras_q     <= '1;
+      f_wr_q      <= '1;
+      f_rdb_q     <= '1;
+      f_rrd_q     <= 1'b1;
+      f_rfc_q     <= 1'b1;
+      f_mrd_q     <= 1'b1;
+      f_bl_q      <= 1'b1;
+      f_rdwr_q    <= 1'b1;
       cur_valid_q <= 1'b0;
       cur_write_q <= 1'b0;
       cur_beat_q  <= 1'b0;
       cur_addr_q  <= '0;
       cur_data_q  <= '0;
       cur_tag_q   <= '0;
+      cur_open_q  <= 1'b0;
+      cur_hit_q   <= 1'b0;
+      iss_tag_q   <= '0;
       cmd_q       <= CmdNop;
       ba_q        <= '0;
       a_q         <= '0;
@@ -451,6 +505,7 @@ module de_sdram_ctrl #(
       wait_q      <= wait_d;
       init_ref_q  <= init_ref_d;
       ref_cnt_q   <= ref_cnt_d;
+      ref_due_q   <= ref_due_d;
       open_q      <= open_d;
       row_q       <= row_d;
       s_act_q     <= s_act_d;
@@ -461,12 +516,26 @@ module de_sdram_ctrl #(
       s_read_q    <= s_read_d;
       s_ref_q     <= s_ref_d;
       s_mrs_q     <= s_mrs_d;
+      f_rcd_q     <= f_rcd_d;
+      f_rp_q      <= f_rp_d;
+      f_rc_q      <= f_rc_d;
+      f_ras_q     <= f_ras_d;
+      f_wr_q      <= f_wr_d;
+      f_rdb_q     <= f_rdb_d;
+      f_rrd_q     <= f_rrd_d;
+      f_rfc_q     <= f_rfc_d;
+      f_mrd_q     <= f_mrd_d;
+      f_bl_q      <= f_bl_d;
+      f_rdwr_q    <= f_rdwr_d;
       cur_valid_q <= cur_valid_d;
       cur_write_q <= cur_write_d;
       cur_beat_q  <= cur_beat_d;
       cur_addr_q  <= cur_addr_d;
       cur_data_q  <= cur_data_d;
       cur_tag_q   <= cur_tag_d;
+      cur_open_q  <= cur_open_d;
+      cur_hit_q   <= cur_hit_d;
+      iss_tag_q   <= iss_tag_d;
       cmd_q       <= cmd_d;
       ba_q        <= ba_d;
       a_q         <= a_d;
