@@ -1,0 +1,576 @@
+// SDR SDRAM controller for the board's frame store (docs/sdram.md §2): the ULX3S's
+// 16-bit MT48LC16M16A2 (4 banks x 8192 rows x 512 columns), one clock domain (clk_i is
+// the SDRAM clock; the board shell shifts the pin clock's phase).
+//
+// * Power-up: TinitNs of NOPs, PRECHARGE ALL, 2 x AUTO REFRESH, LOAD MODE REGISTER
+//   (burst length 8, sequential, CAS latency CasLatency, single-location writes).
+// * Refresh: one AUTO REFRESH every tREFI - RefMargin clocks (precharging the open rows
+//   first), so no refresh is ever postponed: the gap between two REFs stays below tREFI
+//   even when a request is being finished.
+// * Open-row policy, one row per bank: an access to the open row goes straight to READ
+//   or WRITE; a miss precharges and activates its bank. Every constraint is a counter
+//   per bank (since ACT, since PRECHARGE, since READ, since WRITE) or per device, so a
+//   miss in one bank is served under the data burst of another (a row change costs
+//   nothing when the PRECHARGE and ACT fit in the 8 clocks of the burst before).
+// * Read port: a request is 4 consecutive 32-bit words (one BL8 burst, 8 beats), address
+//   aligned to 4 words; the words come back in order on rd_valid_o, one every 2 clocks,
+//   CasLatency + 2 clocks after the READ left, with the request's tag. There is no
+//   back-pressure: a requester asks only when it has room for 4 words (credit).
+//   Requests to open rows run back to back: one READ every 8 clocks, the data bus full.
+// * Write port: one 32-bit word, written as two single-location WRITEs (low half at the
+//   even column); writes are for the loader, so reads have priority.
+//
+// Address map (word address, 4-byte words): {bank, row, column[8:1]}; a colour's frame
+// store in a bank of its own keeps the three colours' rows open at the same time.
+`default_nettype none
+
+module de_sdram_ctrl #(
+  parameter int unsigned TckPs      = 8000,     // 125 MHz
+  parameter int unsigned CasLatency = 3,
+  parameter int unsigned BankBits   = 2,
+  parameter int unsigned RowBits    = 13,
+  parameter int unsigned ColBits    = 9,
+  // Timings of the part, picoseconds (MT48LC16M16A2-6A).
+  parameter int unsigned TrcdPs     = 18000,
+  parameter int unsigned TrpPs      = 18000,
+  parameter int unsigned TrasPs     = 42000,
+  parameter int unsigned TrcPs      = 60000,
+  parameter int unsigned TrrdPs     = 12000,
+  parameter int unsigned TrfcPs     = 60000,
+  parameter int unsigned TwrPs      = 12000,
+  parameter int unsigned TmrdCk     = 2,
+  parameter int unsigned TrefiPs    = 7_812_500,  // 64 ms / 8192 rows
+  parameter int unsigned TinitNs    = 100_000,    // power-up wait
+  parameter int unsigned RefMargin  = 64,         // clocks of slack before tREFI
+  parameter int unsigned TagW       = 2,
+  localparam int unsigned AW        = BankBits + RowBits + ColBits - 1,  // word address
+  localparam int unsigned PinAW     = RowBits
+) (
+  input  logic                clk_i,
+  input  logic                rst_i,
+  // Write port: one 32-bit word.
+  input  logic                wr_valid_i,
+  output logic                wr_ready_o,
+  input  logic [AW-1:0]       wr_addr_i,
+  input  logic [31:0]         wr_data_i,
+  // Read port: one request = 4 words from rd_req_addr_i (bits [1:0] ignored).
+  input  logic                rd_req_valid_i,
+  output logic                rd_req_ready_o,
+  input  logic [AW-1:0]       rd_req_addr_i,
+  input  logic [TagW-1:0]     rd_req_tag_i,
+  output logic                rd_valid_o,
+  output logic [31:0]         rd_data_o,
+  output logic [TagW-1:0]     rd_tag_o,
+  output logic                rd_last_o,      // 4th word of a request
+  // Status.
+  output logic                init_done_o,
+  output logic                refresh_o,      // one clock per AUTO REFRESH issued
+  // SDRAM pins (registered).
+  output logic                sd_cke_o,
+  output logic                sd_cs_n_o,
+  output logic                sd_ras_n_o,
+  output logic                sd_cas_n_o,
+  output logic                sd_we_n_o,
+  output logic [BankBits-1:0] sd_ba_o,
+  output logic [PinAW-1:0]    sd_a_o,
+  output logic [1:0]          sd_dqm_o,
+  output logic [15:0]         sd_dq_o,
+  output logic                sd_dq_oe_o,
+  input  logic [15:0]         sd_dq_i
+);
+  // ---------------------------------------------------------------- parameter checks
+  if (CasLatency != 2 && CasLatency != 3) begin : g_err_cl
+    $error("de_sdram_ctrl: CasLatency must be 2 or 3");
+  end
+  if (RowBits < ColBits + 2 || RowBits < 11 || ColBits < 8) begin : g_err_geom
+    $error("de_sdram_ctrl: RowBits >= ColBits + 2 (A10 and the column share the pins)");
+  end
+  if (TckPs < 5000) begin : g_err_tck
+    $error("de_sdram_ctrl: TckPs >= 5000");
+  end
+
+  // ---------------------------------------------------------------- timings in clocks
+  localparam int unsigned NRcd  = (TrcdPs + TckPs - 1) / TckPs;
+  localparam int unsigned NRp   = (TrpPs + TckPs - 1) / TckPs;
+  localparam int unsigned NRas  = (TrasPs + TckPs - 1) / TckPs;
+  localparam int unsigned NRc   = (TrcPs + TckPs - 1) / TckPs;
+  localparam int unsigned NRrd  = (TrrdPs + TckPs - 1) / TckPs;
+  localparam int unsigned NRfc  = (TrfcPs + TckPs - 1) / TckPs;
+  localparam int unsigned NWr   = (TwrPs + TckPs - 1) / TckPs;
+  localparam int unsigned NMrd  = TmrdCk;
+  localparam int unsigned NBl   = 8;                                   // beats per READ
+  localparam int unsigned NRefi = TrefiPs / TckPs - RefMargin;
+  localparam int unsigned NInit = (TinitNs * 1000 + TckPs - 1) / TckPs;
+  localparam int unsigned NBanks = 1 << BankBits;
+  localparam int unsigned PipeL  = CasLatency + NBl;
+
+  if (NRefi < 64 || NRefi > 65535 || NInit > 1048575) begin : g_err_ref
+    $error("de_sdram_ctrl: tREFI / tInit out of the counters' range");
+  end
+
+  // "since" counters count clocks since a command and saturate at 255 ("long ago"). A
+  // command in the clock after another is 1 clock after it, so "a gap of at least N
+  // clocks" is since_q >= N - 1. For 125 MHz that test is registered: the flag f_*_q
+  // says it for this clock, computed in the clock before from the counter and from
+  // whether the command restarts it now (ge_next), so no comparator sits between the
+  // command decision and the pins.
+  localparam int unsigned SW = 8;
+  typedef logic [SW-1:0] since_t;
+
+  if (NRc > 200 || NRfc > 200 || NRas > 200 || NRcd < 1 || NRp < 1 || NWr < 1 ||
+      NMrd < 1) begin : g_err_since
+    $error("de_sdram_ctrl: a timing is out of the 8-bit counters' range (1..200 clocks)");
+  end
+
+  function automatic since_t inc(since_t v);
+    return (v == {SW{1'b1}}) ? v : v + 1'b1;
+  endfunction
+
+  // Next clock's "gap >= n": restarted now -> since 0 >= n - 1; else inc(v) >= n - 1.
+  function automatic logic ge_next(since_t v, logic restart, int unsigned n);
+    if (restart) return n <= 1;
+    return (n <= 2) || (32'(v) >= n - 2);
+  endfunction
+
+  // {cs_n, ras_n, cas_n, we_n}
+  localparam logic [3:0] CmdNop   = 4'b0111;
+  localparam logic [3:0] CmdAct   = 4'b0011;
+  localparam logic [3:0] CmdRead  = 4'b0101;
+  localparam logic [3:0] CmdWrite = 4'b0100;
+  localparam logic [3:0] CmdPre   = 4'b0010;
+  localparam logic [3:0] CmdRef   = 4'b0001;
+  localparam logic [3:0] CmdLmr   = 4'b0000;
+
+  // Mode register: single-location writes (A9), CL, sequential, BL 8.
+  localparam logic [PinAW-1:0] ModeWord =
+      PinAW'({1'b1, 2'b00, 3'(CasLatency), 1'b0, 3'b011});
+
+  typedef enum logic [2:0] {
+    SInitWait, SInitPre, SInitRef, SInitLmr, SRun, SRefPre, SRef
+  } state_e;
+
+  typedef struct packed {
+    logic            valid;
+    logic            odd;
+    logic            last;
+    logic [TagW-1:0] tag;
+  } beat_t;
+
+  // ---------------------------------------------------------------- state
+  state_e state_d, state_q;
+  logic [19:0] wait_d, wait_q;
+  logic        init_ref_d, init_ref_q;     // the first init REF has gone
+  logic [15:0] ref_cnt_d, ref_cnt_q;
+  logic        ref_due_d, ref_due_q;       // ref_cnt_q >= NRefi
+
+  logic [NBanks-1:0]              open_d, open_q;
+  logic [NBanks-1:0][RowBits-1:0] row_d, row_q;
+  since_t [NBanks-1:0] s_act_d, s_act_q, s_pre_d, s_pre_q, s_rd_d, s_rd_q, s_wr_d, s_wr_q;
+  since_t s_act_any_d, s_act_any_q, s_read_d, s_read_q, s_ref_d, s_ref_q, s_mrs_d, s_mrs_q;
+  // Restart strobes of the counters (this clock's command).
+  logic [NBanks-1:0] r_act, r_pre, r_rd, r_wr;
+  logic              r_act_any, r_read, r_ref, r_mrs, r_refcnt;
+  // Registered gap flags: per bank tRCD, tRP, tRC, tRAS, tWR, own burst out; device tRRD,
+  // tRFC, tMRD, READ-to-READ (8 beats), READ-to-WRITE (bus free).
+  logic [NBanks-1:0] f_rcd_d, f_rcd_q, f_rp_d, f_rp_q, f_rc_d, f_rc_q, f_ras_d, f_ras_q;
+  logic [NBanks-1:0] f_wr_d, f_wr_q, f_rdb_d, f_rdb_q;
+  logic              f_rrd_d, f_rrd_q, f_rfc_d, f_rfc_q, f_mrd_d, f_mrd_q;
+  logic              f_bl_d, f_bl_q, f_rdwr_d, f_rdwr_q;
+
+  // The request being served.
+  logic                cur_valid_d, cur_valid_q;
+  logic                cur_write_d, cur_write_q;
+  logic                cur_beat_d, cur_beat_q;       // write: high half next
+  logic [AW-1:0]       cur_addr_d, cur_addr_q;
+  logic [31:0]         cur_data_d, cur_data_q;
+  logic [TagW-1:0]     cur_tag_d, cur_tag_q;
+  logic                cur_open_d, cur_open_q;       // its bank has a row open
+  logic                cur_hit_d, cur_hit_q;         // ... and it is the request's row
+  logic [TagW-1:0]     iss_tag_d, iss_tag_q;         // tag of the READ on the pins
+
+  // Pins.
+  logic [3:0]          cmd_d, cmd_q;
+  logic [BankBits-1:0] ba_d, ba_q;
+  logic [PinAW-1:0]    a_d, a_q;
+  logic [15:0]         dq_d, dq_q;
+  logic                dq_oe_d, dq_oe_q;
+  logic                cke_q;
+
+  // Read data.
+  beat_t [PipeL-1:0]   pipe_d, pipe_q;
+  logic [15:0]         low_d, low_q;
+  logic                rdv_d, rdv_q, rdl_d, rdl_q;
+  logic [31:0]         rdd_d, rdd_q;
+  logic [TagW-1:0]     rdt_d, rdt_q;
+
+  // ---------------------------------------------------------------- request decode
+  logic [BankBits-1:0]  cur_bank;
+  logic [RowBits-1:0]   cur_row;
+  logic [ColBits-2:0]   cur_colw;
+  assign cur_bank = cur_addr_q[AW-1 -: BankBits];
+  assign cur_row  = cur_addr_q[ColBits-1 +: RowBits];
+  assign cur_colw = cur_addr_q[ColBits-2:0];
+
+  logic accept;
+  assign accept         = (state_q == SRun) && !cur_valid_q && !ref_due_q;
+  assign rd_req_ready_o = accept;
+  assign wr_ready_o     = accept && !rd_req_valid_i;
+
+  // ---------------------------------------------------------------- command decision
+  logic hit, miss_open, can_act, can_pre, can_read, can_write, all_pre_ok, all_closed_ok;
+
+  always_comb begin
+    hit       = cur_hit_q;
+    miss_open = cur_open_q && !cur_hit_q;
+    can_act   = f_rp_q[cur_bank] && f_rc_q[cur_bank] && f_rrd_q && f_rfc_q && f_mrd_q;
+    // A PRECHARGE ends the bank's read data CasLatency-1 clocks later: not before the
+    // 8 beats of its last READ are out (f_rdb).
+    can_pre   = f_ras_q[cur_bank] && f_wr_q[cur_bank] && f_rdb_q[cur_bank];
+    can_read  = hit && f_rcd_q[cur_bank] && f_bl_q;
+    // The write data must not meet read data on DQ: the last READ's beats are on the
+    // bus until CasLatency + 7 clocks after it (f_rdwr).
+    can_write = hit && f_rcd_q[cur_bank] && f_rdwr_q;
+    all_pre_ok    = &(~open_q | (f_ras_q & f_wr_q & f_rdb_q));
+    all_closed_ok = &f_rp_q;
+  end
+
+  always_comb begin
+    state_d     = state_q;
+    wait_d      = (wait_q != '0) ? wait_q - 1'b1 : wait_q;
+    init_ref_d  = init_ref_q;
+    r_refcnt    = (state_q == SInitWait || state_q == SInitPre || state_q == SInitRef ||
+                   state_q == SInitLmr);
+    open_d      = open_q;
+    row_d       = row_q;
+    r_act       = '0;
+    r_pre       = '0;
+    r_rd        = '0;
+    r_wr        = '0;
+    r_act_any   = 1'b0;
+    r_read      = 1'b0;
+    r_ref       = 1'b0;
+    r_mrs       = 1'b0;
+    cur_valid_d = cur_valid_q;
+    cur_write_d = cur_write_q;
+    cur_beat_d  = cur_beat_q;
+    cur_addr_d  = cur_addr_q;
+    cur_data_d  = cur_data_q;
+    cur_tag_d   = cur_tag_q;
+    cur_open_d  = cur_open_q;
+    cur_hit_d   = cur_hit_q;
+    iss_tag_d   = iss_tag_q;
+    cmd_d       = CmdNop;
+    ba_d        = ba_q;
+    a_d         = a_q;
+    dq_d        = dq_q;
+    dq_oe_d     = 1'b0;
+    refresh_o   = 1'b0;
+
+    unique case (state_q)
+      SInitWait: begin
+        if (wait_q == '0) state_d = SInitPre;
+      end
+      SInitPre: begin
+        cmd_d   = CmdPre;
+        a_d     = '0;
+        a_d[10] = 1'b1;                                    // all banks
+        r_pre   = '1;
+        state_d = SInitRef;
+      end
+      SInitRef: begin
+        if (all_closed_ok && f_rfc_q) begin
+          cmd_d      = CmdRef;
+          r_ref      = 1'b1;
+          init_ref_d = 1'b1;
+          if (init_ref_q) state_d = SInitLmr;
+        end
+      end
+      SInitLmr: begin
+        if (f_rfc_q) begin
+          cmd_d   = CmdLmr;
+          ba_d    = '0;
+          a_d     = ModeWord;
+          r_mrs   = 1'b1;
+          state_d = SRun;
+        end
+      end
+      SRun: begin
+        if (!cur_valid_q) begin
+          if (ref_due_q) begin
+            state_d = SRefPre;
+          end else if (rd_req_valid_i) begin
+            cur_valid_d = 1'b1;
+            cur_write_d = 1'b0;
+            cur_addr_d  = {rd_req_addr_i[AW-1:2], 2'b00};
+            cur_tag_d   = rd_req_tag_i;
+          end else if (wr_valid_i) begin
+            cur_valid_d = 1'b1;
+            cur_write_d = 1'b1;
+            cur_beat_d  = 1'b0;
+            cur_addr_d  = wr_addr_i;
+            cur_data_d  = wr_data_i;
+          end
+          // No command goes in this clock, so open_q / row_q are final: whether the new
+          // request's row is open is decided here, off the command path.
+          cur_open_d = open_q[cur_addr_d[AW-1 -: BankBits]];
+          cur_hit_d  = cur_open_d &&
+                       (row_q[cur_addr_d[AW-1 -: BankBits]] == cur_addr_d[ColBits-1 +: RowBits]);
+        end else if (cur_write_q && cur_beat_q) begin
+          // Second beat of a write: the high half, one column on, the next clock.
+          cmd_d    = CmdWrite;
+          ba_d     = cur_bank;
+          a_d      = PinAW'({cur_colw, 1'b1});
+          dq_d     = cur_data_q[31:16];
+          dq_oe_d  = 1'b1;
+          r_wr[cur_bank] = 1'b1;
+          cur_valid_d = 1'b0;
+          cur_beat_d  = 1'b0;
+        end else if (miss_open) begin
+          if (can_pre) begin
+            cmd_d = CmdPre;
+            ba_d  = cur_bank;
+            a_d   = '0;                                    // A10 = 0: this bank only
+            open_d[cur_bank] = 1'b0;
+            r_pre[cur_bank]  = 1'b1;
+            cur_open_d       = 1'b0;
+          end
+        end else if (!hit) begin
+          if (can_act) begin
+            cmd_d = CmdAct;
+            ba_d  = cur_bank;
+            a_d   = cur_row;
+            open_d[cur_bank] = 1'b1;
+            row_d[cur_bank]  = cur_row;
+            r_act[cur_bank]  = 1'b1;
+            r_act_any        = 1'b1;
+            cur_open_d       = 1'b1;
+            cur_hit_d        = 1'b1;
+          end
+        end else if (cur_write_q) begin
+          if (can_write) begin
+            cmd_d   = CmdWrite;
+            ba_d    = cur_bank;
+            a_d     = PinAW'({cur_colw, 1'b0});
+            dq_d    = cur_data_q[15:0];
+            dq_oe_d = 1'b1;
+            r_wr[cur_bank] = 1'b1;
+            cur_beat_d = 1'b1;
+          end
+        end else if (can_read) begin
+          cmd_d = CmdRead;
+          ba_d  = cur_bank;
+          a_d   = PinAW'({cur_colw, 1'b0});
+          r_rd[cur_bank] = 1'b1;
+          r_read      = 1'b1;
+          iss_tag_d   = cur_tag_q;
+          cur_valid_d = 1'b0;
+        end
+      end
+      SRefPre: begin
+        if (open_q == '0) begin
+          state_d = SRef;
+        end else if (all_pre_ok) begin
+          cmd_d   = CmdPre;
+          a_d     = '0;
+          a_d[10] = 1'b1;
+          r_pre   = open_q;
+          open_d  = '0;
+          state_d = SRef;
+        end
+      end
+      SRef: begin
+        if (all_closed_ok && f_rfc_q) begin
+          cmd_d     = CmdRef;
+          r_ref     = 1'b1;
+          r_refcnt  = 1'b1;
+          refresh_o = 1'b1;
+          state_d   = SRun;
+        end
+      end
+      default: state_d = SInitWait;
+    endcase
+  end
+
+  // ---------------------------------------------------------------- counters and flags
+  always_comb begin
+    ref_cnt_d   = r_refcnt ? '0 : ((ref_cnt_q == '1) ? ref_cnt_q : ref_cnt_q + 1'b1);
+    ref_due_d   = !r_refcnt && (ref_cnt_q >= 16'(NRefi - 1));
+    s_act_any_d = r_act_any ? '0 : inc(s_act_any_q);
+    s_read_d    = r_read ? '0 : inc(s_read_q);
+    s_ref_d     = r_ref ? '0 : inc(s_ref_q);
+    s_mrs_d     = r_mrs ? '0 : inc(s_mrs_q);
+    f_rrd_d     = ge_next(s_act_any_q, r_act_any, NRrd);
+    f_bl_d      = ge_next(s_read_q, r_read, NBl);
+    f_rdwr_d    = ge_next(s_read_q, r_read, CasLatency + NBl);
+    f_rfc_d     = ge_next(s_ref_q, r_ref, NRfc);
+    f_mrd_d     = ge_next(s_mrs_q, r_mrs, NMrd);
+    for (int unsigned b = 0; b < NBanks; b++) begin
+      s_act_d[b] = r_act[b] ? '0 : inc(s_act_q[b]);
+      s_pre_d[b] = r_pre[b] ? '0 : inc(s_pre_q[b]);
+      s_rd_d[b]  = r_rd[b] ? '0 : inc(s_rd_q[b]);
+      s_wr_d[b]  = r_wr[b] ? '0 : inc(s_wr_q[b]);
+      f_rcd_d[b] = ge_next(s_act_q[b], r_act[b], NRcd);
+      f_rc_d[b]  = ge_next(s_act_q[b], r_act[b], NRc);
+      f_ras_d[b] = ge_next(s_act_q[b], r_act[b], NRas);
+      f_rp_d[b]  = ge_next(s_pre_q[b], r_pre[b], NRp);
+      f_wr_d[b]  = ge_next(s_wr_q[b], r_wr[b], NWr);
+      f_rdb_d[b] = ge_next(s_rd_q[b], r_rd[b], NBl);
+    end
+  end
+
+  // ---------------------------------------------------------------- read data
+  always_comb begin
+    pipe_d = '0;
+    for (int unsigned j = 0; j + 1 < PipeL; j++) pipe_d[j] = pipe_q[j + 1];
+    if (cmd_q == CmdRead) begin
+      // Beat i is on DQ at the SDRAM's edge READ + CasLatency + i; the READ is on the
+      // pins now (the SDRAM takes it at the next edge), so beat i is captured
+      // CasLatency + i clocks after that edge: pipe position CasLatency - 1 + i after it.
+      for (int unsigned i = 0; i < NBl; i++) begin
+        pipe_d[CasLatency - 1 + i].valid = 1'b1;
+        pipe_d[CasLatency - 1 + i].odd   = i[0];
+        pipe_d[CasLatency - 1 + i].last  = (i == NBl - 1);
+        pipe_d[CasLatency - 1 + i].tag   = iss_tag_q;
+      end
+    end
+    low_d = low_q;
+    rdv_d = 1'b0;
+    rdl_d = 1'b0;
+    rdd_d = rdd_q;
+    rdt_d = rdt_q;
+    if (pipe_q[0].valid) begin
+      if (!pipe_q[0].odd) begin
+        low_d = sd_dq_i;
+      end else begin
+        rdv_d = 1'b1;
+        rdl_d = pipe_q[0].last;
+        rdd_d = {sd_dq_i, low_q};
+        rdt_d = pipe_q[0].tag;
+      end
+    end
+  end
+
+  // ---------------------------------------------------------------- registers
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      state_q     <= SInitWait;
+      wait_q      <= 20'(NInit);
+      init_ref_q  <= 1'b0;
+      ref_cnt_q   <= '0;
+      ref_due_q   <= 1'b0;
+      open_q      <= '0;
+      row_q       <= '0;
+      s_act_q     <= '1;
+      s_pre_q     <= '1;
+      s_rd_q      <= '1;
+      s_wr_q      <= '1;
+      s_act_any_q <= '1;
+      s_read_q    <= '1;
+      s_ref_q     <= '1;
+      s_mrs_q     <= '1;
+      f_rcd_q     <= '1;
+      f_rp_q      <= '1;
+      f_rc_q      <= '1;
+      f_ras_q     <= '1;
+      f_wr_q      <= '1;
+      f_rdb_q     <= '1;
+      f_rrd_q     <= 1'b1;
+      f_rfc_q     <= 1'b1;
+      f_mrd_q     <= 1'b1;
+      f_bl_q      <= 1'b1;
+      f_rdwr_q    <= 1'b1;
+      cur_valid_q <= 1'b0;
+      cur_write_q <= 1'b0;
+      cur_beat_q  <= 1'b0;
+      cur_addr_q  <= '0;
+      cur_data_q  <= '0;
+      cur_tag_q   <= '0;
+      cur_open_q  <= 1'b0;
+      cur_hit_q   <= 1'b0;
+      iss_tag_q   <= '0;
+      cmd_q       <= CmdNop;
+      ba_q        <= '0;
+      a_q         <= '0;
+      dq_q        <= '0;
+      dq_oe_q     <= 1'b0;
+      cke_q       <= 1'b1;
+      pipe_q      <= '0;
+      low_q       <= '0;
+      rdv_q       <= 1'b0;
+      rdl_q       <= 1'b0;
+      rdd_q       <= '0;
+      rdt_q       <= '0;
+    end else begin
+      state_q     <= state_d;
+      wait_q      <= wait_d;
+      init_ref_q  <= init_ref_d;
+      ref_cnt_q   <= ref_cnt_d;
+      ref_due_q   <= ref_due_d;
+      open_q      <= open_d;
+      row_q       <= row_d;
+      s_act_q     <= s_act_d;
+      s_pre_q     <= s_pre_d;
+      s_rd_q      <= s_rd_d;
+      s_wr_q      <= s_wr_d;
+      s_act_any_q <= s_act_any_d;
+      s_read_q    <= s_read_d;
+      s_ref_q     <= s_ref_d;
+      s_mrs_q     <= s_mrs_d;
+      f_rcd_q     <= f_rcd_d;
+      f_rp_q      <= f_rp_d;
+      f_rc_q      <= f_rc_d;
+      f_ras_q     <= f_ras_d;
+      f_wr_q      <= f_wr_d;
+      f_rdb_q     <= f_rdb_d;
+      f_rrd_q     <= f_rrd_d;
+      f_rfc_q     <= f_rfc_d;
+      f_mrd_q     <= f_mrd_d;
+      f_bl_q      <= f_bl_d;
+      f_rdwr_q    <= f_rdwr_d;
+      cur_valid_q <= cur_valid_d;
+      cur_write_q <= cur_write_d;
+      cur_beat_q  <= cur_beat_d;
+      cur_addr_q  <= cur_addr_d;
+      cur_data_q  <= cur_data_d;
+      cur_tag_q   <= cur_tag_d;
+      cur_open_q  <= cur_open_d;
+      cur_hit_q   <= cur_hit_d;
+      iss_tag_q   <= iss_tag_d;
+      cmd_q       <= cmd_d;
+      ba_q        <= ba_d;
+      a_q         <= a_d;
+      dq_q        <= dq_d;
+      dq_oe_q     <= dq_oe_d;
+      cke_q       <= 1'b1;
+      pipe_q      <= pipe_d;
+      low_q       <= low_d;
+      rdv_q       <= rdv_d;
+      rdl_q       <= rdl_d;
+      rdd_q       <= rdd_d;
+      rdt_q       <= rdt_d;
+    end
+  end
+
+  assign sd_cke_o    = cke_q;
+  assign sd_cs_n_o   = cmd_q[3];
+  assign sd_ras_n_o  = cmd_q[2];
+  assign sd_cas_n_o  = cmd_q[1];
+  assign sd_we_n_o   = cmd_q[0];
+  assign sd_ba_o     = ba_q;
+  assign sd_a_o      = a_q;
+  assign sd_dqm_o    = 2'b00;
+  assign sd_dq_o     = dq_q;
+  assign sd_dq_oe_o  = dq_oe_q;
+  assign rd_valid_o  = rdv_q;
+  assign rd_data_o   = rdd_q;
+  assign rd_tag_o    = rdt_q;
+  assign rd_last_o   = rdl_q;
+  assign init_done_o = (state_q == SRun) || (state_q == SRefPre) || (state_q == SRef);
+
+  // A read request is 4 aligned words: the address's two low bits are not used.
+  logic unused_rd_lo;
+  assign unused_rd_lo = ^rd_req_addr_i[1:0];
+
+endmodule
+
+`default_nettype wire

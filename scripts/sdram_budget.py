@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""SDRAM frame-store bandwidth budget and prefetch FIFO depth (docs/sdram.md §3).
+
+For each scene, `yproc scan` at 640x480 writes the three colour streams; the words per
+line (one 32-bit frame-store word per bus slot, the end-of-line marker included) are
+played against an SDRAM that delivers R words per pixel clock in bursts of B words to
+three per-colour prefetch FIFOs of depth D, round-robin among the FIFOs with room for a
+burst. The display side takes, per colour, the words of line v+1 one per pixel clock
+from the start of line v's window (h = 1 .. HTotal-1, docs/display-controller.md), the
+worst case for the FIFO; a line whose words are not all taken by the window's end is
+late. The smallest D with no late line, over two frames starting from full FIFOs in
+vertical blanking, is the depth the colour needs.
+
+    scripts/sdram_budget.py [--scenes teapot,cad] [--rates 2.375,1.484] [--burst 4]
+
+A rate is words per pixel clock: f_sdram x efficiency / 2 beats per word / 25 MHz.
+"""
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = {"teapot": "sw/scenes/teapot/teapot.scene", "cad": "sw/scenes/cad/cad.scene"}
+H_TOTAL, V_ACTIVE, V_TOTAL = 800, 480, 525
+
+
+def words_per_line(path: Path) -> list[int]:
+    """One frame-store word per bus slot: the slots of each line, its marker included."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from bench_span import slots_per_line
+    return slots_per_line(path)
+
+
+def late_lines(lines: list[list[int]], rate: float, burst: int, depth: int,
+               frames: int = 2) -> tuple[int, int]:
+    """(late lines, lowest FIFO level seen at a line's end) for FIFOs of `depth` words."""
+    nc = len(lines)
+    fifo = [depth] * nc                 # full: prefetched during vertical blanking
+    credit = 0.0
+    rr = 0
+    late = 0
+    for _ in range(frames):
+        for v in range(V_TOTAL):
+            # The window in line v belongs to line v+1 (line 0's window is in line 524).
+            nxt = (v + 1) % V_TOTAL
+            want = [lines[c][nxt] if nxt < V_ACTIVE else 0 for c in range(nc)]
+            for h in range(H_TOTAL):
+                credit += rate
+                while credit >= burst:
+                    for k in range(nc):
+                        c = (rr + k) % nc
+                        if fifo[c] + burst <= depth:
+                            fifo[c] += burst
+                            rr = (c + 1) % nc
+                            credit -= burst
+                            break
+                    else:
+                        credit = min(credit, float(burst))   # all full: the SDRAM idles
+                        break
+                if h == 0:
+                    continue             # the Refresh slot
+                for c in range(nc):
+                    if want[c] and fifo[c]:
+                        fifo[c] -= 1
+                        want[c] -= 1
+            late += sum(1 for c in range(nc) if want[c])
+    return late, 0
+
+
+def min_depth(lines, rate, burst) -> int:
+    lo, hi = burst, 1 << 16
+    if late_lines(lines, rate, burst, hi)[0]:
+        return -1
+    while lo < hi:
+        mid = (lo + hi) // 2
+        mid -= mid % burst
+        mid = max(mid, lo)
+        if late_lines(lines, rate, burst, mid)[0]:
+            lo = mid + burst
+        else:
+            hi = mid
+    return lo
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenes", default="teapot,cad")
+    ap.add_argument("--rates", default="2.375,1.484")
+    ap.add_argument("--burst", type=int, default=4)
+    a = ap.parse_args()
+    subprocess.run(["make", "-s", "-C", "sw/hsr", "build/yproc"], cwd=ROOT, check=True)
+    tmp = Path(tempfile.mkdtemp(prefix="sdram_budget_"))
+    print("| scene | words/line per colour mean / max | 3 colours: max line, words | "
+          "rate, words/pixel clock | FIFO depth per colour, words |")
+    print("|---|---|---|---|---|")
+    for name in a.scenes.split(","):
+        d = tmp / name
+        d.mkdir()
+        subprocess.run([str(ROOT / "sw/hsr/build/yproc"), "scan", SCENES[name], "-o", str(d)],
+                       cwd=ROOT, check=True, capture_output=True)
+        lines = [words_per_line(d / f"{ch}.de48") for ch in "rgb"]
+        tot = [sum(c[v] for c in lines) for v in range(V_ACTIVE)]
+        stats = " / ".join(f"{sum(c) / len(c):.0f}-{max(c)}" for c in lines)
+        for rate in (float(r) for r in a.rates.split(",")):
+            dep = min_depth(lines, rate, a.burst)
+            print(f"| {name} | {stats} | {max(tot)} | {rate:.3f} | "
+                  f"{dep if dep >= 0 else 'none (average exceeds the rate)'} |", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
