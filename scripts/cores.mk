@@ -9,7 +9,7 @@
 # writes; make remakes it (and re-reads it) only when a .core file or filelist.py is newer,
 # so an up-to-date build does not start FuseSoC.
 CORES_BUILD := $(ROOT)/build/cores
-CORE_DEFS := $(wildcard $(ROOT)/rtl/*/*.core $(ROOT)/sim/fast/*.core $(ROOT)/fpga/*.core \
+CORE_DEFS := $(wildcard $(ROOT)/rtl/*/*.core $(ROOT)/sim/*/*.core $(ROOT)/fpga/*.core \
   $(ROOT)/tb/*/*.core)
 include $(foreach c,$(CORES),$(CORES_BUILD)/$(c).mk)
 $(CORES_BUILD)/%.mk: $(CORE_DEFS) $(ROOT)/scripts/filelist.py

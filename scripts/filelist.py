@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The RTL file lists of every tool, from the FuseSoC cores (docs/simulation.md, "File lists").
 
-Each block's `.core` file (CAPI2: rtl/*/*.core, sim/fast/de_fast.core, fpga/de_fpga.core,
+Each block's `.core` file (CAPI2: rtl/*/*.core, sim/*/*.core (sim/fast, sim/models), fpga/de_fpga.core,
 tb/*/*.core) names its files and the cores it depends on; FuseSoC resolves a core and a
 target into one ordered list, dependencies first. This module asks FuseSoC's API for that
 list (the EDAM file's `files`, as `fusesoc run --setup` would write it) and caches it under
@@ -28,12 +28,12 @@ ROOT = Path(__file__).resolve().parents[1]
 CACHE = ROOT / "build" / "cores"
 # Where the project's cores live (`fusesoc --cores-root .` finds the same ones; these
 # folders only keep the scan away from .venv and the build trees).
-CORE_DIRS = ("rtl", "sim/fast", "fpga", "tb")
+CORE_DIRS = ("rtl", "sim/fast", "sim/models", "fpga", "tb")
 HDL_TYPES = ("systemVerilogSource", "verilogSource")
 
 
 # The same patterns as scripts/cores.mk's CORE_DEFS (make's dependencies).
-CORE_GLOBS = ("rtl/*/*.core", "sim/fast/*.core", "fpga/*.core", "tb/*/*.core")
+CORE_GLOBS = ("rtl/*/*.core", "sim/*/*.core", "fpga/*.core", "tb/*/*.core")
 
 
 def core_files() -> list[Path]:

@@ -220,8 +220,7 @@ async def stream(dut):
 # ---- pytest runner --------------------------------------------------------------------------
 
 def test_de_sdram_ctrl():
-    from common.run import RTL, build_and_test
-    build_and_test(HERE, "tb_sdram_ctrl",
-                   [RTL / "board" / "de_sdram_ctrl.sv", ROOT / "sim" / "models" / "sdram_sdr16.sv",
-                    HERE / "tb_sdram_ctrl.sv"],
-                   "test_de_sdram_ctrl", parameters={"TckPs": TCK_PS, "CasLatency": CL})
+    from common.run import build_and_test, rtl_files
+    srcs = rtl_files("diffengine:tb:de_sdram_ctrl")   # tb/de_sdram_ctrl/de_sdram_ctrl_tb.core
+    build_and_test(HERE, "tb_sdram_ctrl", srcs, "test_de_sdram_ctrl",
+                   parameters={"TckPs": TCK_PS, "CasLatency": CL})
