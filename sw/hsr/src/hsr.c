@@ -217,7 +217,9 @@ static hsr_status adopt(hsr_ctx *h, int s, int id, hsr_domain *dom, const ivec *
  * pointer has arrived by then): the slot 4 ahead, its domain 2 ahead, the
  * edges and the parent list 1 ahead.  Only hints: nothing is read from a slot
  * that is not in use, and no result depends on them. */
-static inline void prefetch_cand(const hsr_ctx *h, const ivec *cand, int ci)
+/* always_inline: as a function of its own, GCC finds it free of side effects
+ * (a prefetch is not one) and deletes the call, prefetches and all */
+static inline __attribute__((always_inline)) void prefetch_cand(const hsr_ctx *h, const ivec *cand, int ci)
 {
     if (ci + 4 < cand->n) __builtin_prefetch(&h->l[cand->v[ci + 4]]);
     if (ci + 2 < cand->n) {
