@@ -45,7 +45,7 @@ help:
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
 	@echo "make setup       create .venv from scripts/requirements.txt"
 	@echo "make clean       remove every build product: out/, build/, sim/build, sim/out, sw/hsr/build,"
-	@echo "                 fpga/build, tb/*/sim_build* (keeps .venv and the ccache)"
+	@echo "                 sw/yproc/build, fpga/build, tb/*/sim_build* (keeps .venv and the ccache)"
 
 setup: $(SETUP)
 $(SETUP): scripts/setup.sh scripts/requirements.txt sw/pyproject.toml
@@ -79,7 +79,7 @@ demo-cmd: $(SETUP)
 # compiles), each one's output printed whole when it ends; then the RTL layer.
 # yproc is built first: both layers use it, and two makes must not build it at once.
 test: $(SETUP)
-	@$(MAKE) -s --no-print-directory -j2 -C sw/hsr build/yproc
+	@$(MAKE) -s --no-print-directory -j2 -C sw/yproc build/yproc
 	@$(MAKE) --no-print-directory -j2 --output-sync=target test-py test-c
 	@$(MAKE) --no-print-directory test-rtl
 
@@ -90,6 +90,7 @@ test-py: $(SETUP)
 test-c:
 	@./scripts/ensure_system.sh
 	$(MAKE) -C sw/hsr test
+	$(MAKE) -C sw/yproc test
 	$(MAKE) -C sw/hsr/fuzz smoke
 
 # Coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang; FUZZ_SECONDS each).
@@ -106,7 +107,7 @@ test-rtl: $(SETUP)
 TIER ?= full
 J ?= 2
 sim: $(SETUP)
-	@$(MAKE) -s -C sw/hsr build/yproc
+	@$(MAKE) -s -C sw/yproc build/yproc
 	$(ENV) $(DE) sim --tier $(TIER) -j $(J) $(if $(SHARD),--shard $(SHARD))
 
 # One report and JUnit file from the shards (SHARDS = their folders, CI: the artifacts).
@@ -117,7 +118,7 @@ sim-merge: $(SETUP)
 # meshes with the 69K-triangle bunny (sw/tests/test_meshes.py; make test runs the shipped
 # scenes at 320x240 and leaves the bunny out). About 3.5 min on 2 cores.
 test-quality: $(SETUP)
-	@$(MAKE) -s -C sw/hsr build/yproc
+	@$(MAKE) -s -C sw/yproc build/yproc
 	$(ENV) cd sw && DE_QUALITY_FULL=1 $(PY) -m pytest -q -rA -n $(J) --durations=0 tests/test_meshes.py
 
 # The first-run proof (docs/pipeline.md section 4): removes liblz4-dev, then concurrent
@@ -162,7 +163,7 @@ postsynth: $(SETUP)
 	$(MAKE) -C fpga postsynth
 
 clean:
-	rm -rf $(OUT) build sim/out sim/build sw/hsr/build fpga/build
+	rm -rf $(OUT) build sim/out sim/build sw/hsr/build sw/yproc/build fpga/build
 	find tb -name 'sim_build*' -prune -exec rm -rf {} +
 	rm -f tb/de_array/coverage_*.txt tb/de_array/seed_*.txt
 	git worktree prune 2>/dev/null || true

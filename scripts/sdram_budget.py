@@ -93,7 +93,7 @@ def main() -> int:
     ap.add_argument("--rates", default="2.375,1.484")
     ap.add_argument("--burst", type=int, default=4)
     a = ap.parse_args()
-    subprocess.run(["make", "-s", "-C", "sw/hsr", "build/yproc"], cwd=ROOT, check=True)
+    subprocess.run(["make", "-s", "-C", "sw/yproc", "build/yproc"], cwd=ROOT, check=True)
     tmp = Path(tempfile.mkdtemp(prefix="sdram_budget_"))
     print("| scene | words/line per colour mean / max | 3 colours: max line, words | "
           "rate, words/pixel clock | FIFO depth per colour, words |")
@@ -101,7 +101,7 @@ def main() -> int:
     for name in a.scenes.split(","):
         d = tmp / name
         d.mkdir()
-        subprocess.run([str(ROOT / "sw/hsr/build/yproc"), "scan", SCENES[name], "-o", str(d)],
+        subprocess.run([str(ROOT / "sw/yproc/build/yproc"), "scan", SCENES[name], "-o", str(d)],
                        cwd=ROOT, check=True, capture_output=True)
         lines = [words_per_line(d / f"{ch}.de48") for ch in "rgb"]
         tot = [sum(c[v] for c in lines) for v in range(V_ACTIVE)]

@@ -43,7 +43,7 @@ most 16/256 (one row of samples; observed <= 3/256).
 
 Incremental path (test_hsr_incremental): a random scene, then a random
 sequence of add / remove / move / opacity operations applied by `yproc hsr
-SCENE --ops OPS` (sw/hsr/tools/yproc_ops.c; docs/hsr.md "Operation file").
+SCENE --ops OPS` (sw/yproc/tools/yproc_ops.c; docs/hsr.md "Operation file").
 The resulting map must equal a full rebuild of the final scene (`--ops OPS
 --rebuild`): per MLR id and per ordered parent prefix the same area (1e-9
 relative) and the same region (|symmetric difference| <= 1e-9 relative),
@@ -56,13 +56,11 @@ must be rejected with "file:line: message" (test_hsr_ops_errors).
 """
 from __future__ import annotations
 
-import fcntl
 import json
 import math
 import os
 import random
 import subprocess
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -74,8 +72,7 @@ from shapely.ops import polygonize, unary_union
 from diffengine.host import yproc as yproc_tool
 
 ROOT = Path(__file__).resolve().parents[2]
-HSR = ROOT / "sw" / "hsr"
-YPROC = HSR / "build" / "yproc"
+YPROC = yproc_tool.YPROC
 S = 256.0          # units per pixel (HSR_SUBPIXEL)
 W, H = 48, 36      # screen of the random scenes, pixels
 SS = 16            # supersampling per pixel axis
@@ -83,14 +80,8 @@ SS = 16            # supersampling per pixel axis
 
 @pytest.fixture(scope="session")
 def yproc():
-    """Build sw/hsr/build/yproc once (locked: pytest -n workers share it)."""
-    lock = Path(tempfile.gettempdir()) / "hsr_yproc_build.lock"
-    with open(lock, "w") as fh:
-        fcntl.flock(fh, fcntl.LOCK_EX)
-        r = subprocess.run(["make", "-C", str(HSR), "build/yproc"], capture_output=True, text=True)
-        fcntl.flock(fh, fcntl.LOCK_UN)
-    assert r.returncode == 0, r.stdout + r.stderr
-    return YPROC
+    """sw/yproc/build/yproc, built once (under a lock: pytest -n workers share it)."""
+    return yproc_tool.build()
 
 
 def _seed(salt: int) -> tuple[int, int]:

@@ -1,10 +1,8 @@
 """Shared helpers of the yproc tests (test_yproc_scan.py, test_yproc_anim.py):
-build sw/hsr/build/yproc once, run it, read its outputs (docs/yproc.md)."""
+build sw/yproc/build/yproc once, run it, read its outputs (docs/yproc.md)."""
 from __future__ import annotations
 
-import fcntl
 import subprocess
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -12,21 +10,16 @@ import numpy as np
 from diffengine.formats import binfmt
 from diffengine.model import functional
 from diffengine import isa
+from diffengine.host import yproc as yproc_tool
 
 ROOT = Path(__file__).resolve().parents[2]
 HSR = ROOT / "sw" / "hsr"
-YPROC = HSR / "build" / "yproc"
+YPROC = yproc_tool.YPROC
 SCENES = ROOT / "sw" / "scenes"
 
 
 def build_yproc() -> Path:
-    lock = Path(tempfile.gettempdir()) / "hsr_yproc_build.lock"
-    with open(lock, "w") as fh:
-        fcntl.flock(fh, fcntl.LOCK_EX)
-        r = subprocess.run(["make", "-C", str(HSR), "build/yproc"], capture_output=True, text=True)
-        fcntl.flock(fh, fcntl.LOCK_UN)
-    assert r.returncode == 0, r.stdout + r.stderr
-    return YPROC
+    return yproc_tool.build()
 
 
 def run(*args, ok=True) -> subprocess.CompletedProcess:

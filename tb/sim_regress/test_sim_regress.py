@@ -21,7 +21,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 def test_smoke_tier(tmp_path):
     if not regress_cases.YPROC.exists():  # the scene case needs sw/hsr's y-processor (plain C)
-        subprocess.run(["make", "-s", "-C", str(REPO / "sw" / "hsr"), "build/yproc"],
+        subprocess.run(["make", "-s", "-C", str(REPO / "sw" / "yproc"), "build/yproc"],
                        check=True)
     out = tmp_path / "out"
     rc = cli_main(["sim", "--tier", "smoke", "-j", "2", "--out", str(out)])

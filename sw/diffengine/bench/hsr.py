@@ -35,11 +35,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import REPO as ROOT
+from ..host import yproc as yproc_tool
 from . import record, render as doc
 
 HSR = ROOT / "sw" / "hsr"
 BENCH = HSR / "build" / "hsr_bench"
-YPROC = HSR / "build" / "yproc"
+YPROC = yproc_tool.YPROC
 sys.path.insert(0, str(ROOT / "sw" / "scenes" / "teapot"))
 import make_teapot  # noqa: E402
 
@@ -368,9 +369,10 @@ def command(args) -> int:
     run = record.Run("hsr")
     if args.quick:
         args.queries = min(args.queries, 100)
-    r = subprocess.run(["make", "-C", str(HSR), "build/hsr_bench", "build/yproc"], capture_output=True, text=True)
+    r = subprocess.run(["make", "-C", str(HSR), "build/hsr_bench"], capture_output=True, text=True)
     if r.returncode:
         raise SystemExit(r.stdout + r.stderr)
+    yproc_tool.build()
     load0 = os.getloadavg()[0]
     t_start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="bench_hsr_") as td:

@@ -73,14 +73,14 @@ def configure(ap) -> None:
 
 def command(a) -> int:
     run = record.Run("span")
-    subprocess.run(["make", "-s", "-C", "sw/hsr", "build/yproc"], cwd=ROOT, check=True)
+    subprocess.run(["make", "-s", "-C", "sw/yproc", "build/yproc"], cwd=ROOT, check=True)
     tmp = Path(tempfile.mkdtemp(prefix="bench_span_"))
     rows = []
     for name in a.scenes.split(","):
         d = tmp / name
         d.mkdir()
         log(f"{name}: yproc scan")
-        subprocess.run([str(ROOT / "sw/hsr/build/yproc"), "scan", SCENES[name], "-o", str(d)],
+        subprocess.run([str(ROOT / "sw/yproc/build/yproc"), "scan", SCENES[name], "-o", str(d)],
                        cwd=ROOT, check=True, capture_output=True)
         for ch in "rgb":
             s = d / f"{ch}.de48"

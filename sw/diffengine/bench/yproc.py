@@ -38,7 +38,7 @@ from pathlib import Path
 from .. import REPO as ROOT
 from . import record, render as doc
 
-YPROC = ROOT / "sw" / "hsr" / "build" / "yproc"
+YPROC = ROOT / "sw" / "yproc" / "build" / "yproc"
 SECTION = "## Y-processor: commands per line and host time"
 # Table 7.3 (640x485 at 21.5 MHz, 683 slots per 640-pixel line): slots per pattern row
 TABLE_7_3 = {"phong": 6.5, "gouraud": 4.3, "flat": 3.2}
@@ -119,11 +119,17 @@ def build_rev(rev: str, tmp: Path) -> Path:
     src.mkdir()
     arch = tmp / "base.tar"
     with open(arch, "wb") as f:
-        subprocess.run(["git", "-C", str(ROOT), "archive", rev, "sw/hsr"], stdout=f, check=True)
+        # sw/include and sw/yproc exist only from issue 17 on
+        paths = [p for p in ("sw/hsr", "sw/include", "sw/yproc")
+                 if subprocess.run(["git", "-C", str(ROOT), "cat-file", "-e", f"{rev}:{p}"],
+                                   capture_output=True).returncode == 0]
+        subprocess.run(["git", "-C", str(ROOT), "archive", rev, *paths], stdout=f, check=True)
     with tarfile.open(arch) as t:
         t.extractall(src)
-    subprocess.run(["make", "-s", "-C", str(src / "sw" / "hsr"), "build/yproc"], check=True)
-    return src / "sw" / "hsr" / "build" / "yproc"
+    # before issue 17 the y-processor was built inside sw/hsr
+    home = src / "sw" / ("yproc" if (src / "sw" / "yproc" / "Makefile").exists() else "hsr")
+    subprocess.run(["make", "-s", "-C", str(home), "build/yproc"], check=True)
+    return home / "build" / "yproc"
 
 
 def timed_scan(yproc: Path, scene: Path, out: Path) -> tuple:
@@ -229,7 +235,7 @@ def configure(ap) -> None:
 
 
 def command(a) -> int:
-    if subprocess.run(["make", "-s", "-C", str(ROOT / "sw" / "hsr"), "build/yproc"]).returncode:
+    if subprocess.run(["make", "-s", "-C", str(ROOT / "sw" / "yproc"), "build/yproc"]).returncode:
         return 1
     if a.scaling:
         return scaling(a)

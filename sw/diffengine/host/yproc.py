@@ -1,4 +1,4 @@
-"""The C y-processor's command-line tool, `sw/hsr/build/yproc`, from Python: where it
+"""The C y-processor's command-line tool, `sw/yproc/build/yproc`, from Python: where it
 is, building it once (a file lock, so parallel pytest workers and make do not build it
 together), and `read`, the one scene reader (the C library's; docs/hsr.md "hsr-scene-1")."""
 from __future__ import annotations
@@ -11,8 +11,8 @@ from pathlib import Path
 
 from .. import REPO
 
-HSR = REPO / "sw" / "hsr"
-YPROC = HSR / "build" / "yproc"
+YPROC_DIR = REPO / "sw" / "yproc"
+YPROC = YPROC_DIR / "build" / "yproc"
 
 
 class YprocError(RuntimeError):
@@ -20,17 +20,17 @@ class YprocError(RuntimeError):
 
 
 def build() -> Path:
-    """Build sw/hsr/build/yproc if it is out of date; returns its path."""
+    """Build sw/yproc/build/yproc if it is out of date; returns its path."""
     lock = Path(tempfile.gettempdir()) / "hsr_yproc_build.lock"
     with open(lock, "w") as fh:
         fcntl.flock(fh, fcntl.LOCK_EX)
         try:
-            r = subprocess.run(["make", "-s", "-C", str(HSR), "build/yproc"],
+            r = subprocess.run(["make", "-s", "-C", str(YPROC_DIR), "build/yproc"],
                                capture_output=True, text=True)
         finally:
             fcntl.flock(fh, fcntl.LOCK_UN)
     if r.returncode or not YPROC.exists():
-        raise YprocError("cannot build sw/hsr/build/yproc:\n" + r.stdout + r.stderr)
+        raise YprocError("cannot build sw/yproc/build/yproc:\n" + r.stdout + r.stderr)
     return YPROC
 
 

@@ -1,7 +1,7 @@
 """Incremental animation frames from `yproc anim` (docs/yproc.md): apply the frame deltas
 (.delta, "YPD1") to frame 0's streams and check every frame against a full re-render.
 
-Delta format (written by sw/hsr/tools/yproc_scan.c): "YPD1", u16 version 1, u16 frame,
+Delta format (written by sw/yproc/tools/yproc_scan.c): "YPD1", u16 version 1, u16 frame,
 u16 width, u16 height (big-endian); then per colour r, g, b: u32 number of changed lines
 and per changed line u16 line, u32 words, words x 6-byte .de48 words (the line's commands
 and its closing Refresh).

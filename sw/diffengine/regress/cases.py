@@ -17,7 +17,7 @@ from . import randgen
 
 MANIFEST = REPO / "sim" / "regress" / "manifest.toml"
 OUT = REPO / "sim" / "out"
-YPROC = REPO / "sw" / "hsr" / "build" / "yproc"
+YPROC = REPO / "sw" / "yproc" / "build" / "yproc"
 TIERS = ("smoke", "full", "nightly")   # cumulative: full runs smoke's cases too
 ONE = 1 << isa.FRAC_BITS
 

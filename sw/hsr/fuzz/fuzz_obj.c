@@ -3,7 +3,7 @@
  * for an `mtllib` file, that file's "path:<line>"); a scene that parses
  * builds a visibility map that passes hsr_check, and a y-processor shader. */
 #include <string.h>
-#include "hsr.h"
+#include "yproc.h"
 #include "fuzz.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

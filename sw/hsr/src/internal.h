@@ -139,23 +139,9 @@ typedef struct pair_order {
 void pair_order_make(const hsr_domain *dp, hsr_plane pp, int idp,
                      const hsr_domain *dq, hsr_plane pq, int idq, pair_order *o);
 
-/* project.c: camera basis (u right, v up, w backwards), focal length in px */
-typedef struct scene_view { double u[3], v[3], w[3], f, W, H; } scene_view;
-int scene_view_make(const hsr_scene *sc, scene_view *vw);
-int scene_face_cap(const hsr_scene *sc);
-int scene_face_project(const hsr_scene *sc, const scene_view *vw, int fi, double *a, double *b,
-                       int64_t *q, hsr_plane *plane);
-
 /* obj.c helpers shared with scene.c and mtl.c */
 int scene_grow(void **p, int *cap, int need, size_t sz);
 int scene_tokens(char *line, char **tok, int max);
-/* The next line at *p (moved past it), copied into buf and split into at most max
- * tokens: the token count, -1 if the line does not fit in cap bytes, -2 if it has more
- * than max items. */
-int scene_line(const char **p, char *buf, size_t cap, char **tok, int max);
-int scene_num(const char *s, double *v);
-/* scene.c: a whole text file (NUL bytes rejected); free() *text */
-hsr_status scene_read_file(const char *path, char **text);
 
 /* mtl.c: read the .mtl file at path and append its materials (newmtl, Kd,
  * Ks, Ns, d, Tr) to sc->mat with file = its index in sc->files + 1.

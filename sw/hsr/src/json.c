@@ -1,6 +1,7 @@
 /* json.c - the JSON writers (schemas in docs/hsr.md):
  *   hsr_write_llr_json (--dump-llr): every visible (LLR) domain with its MLR id,
  *     parents, rings and plane, in pixel coordinates;
+ *   hsr_write_input_json (--dump-input): every MLR domain, as the HSR got it;
  *   hsr_write_scene_json (`yproc read`): the scene as the readers understood it, which
  *     is what the Python reference renderer draws from (one scene reader, in C). */
 #include <stddef.h>
@@ -8,6 +9,25 @@
 #include <stdlib.h>
 #include <string.h>
 #include "internal.h"
+
+/* a domain's rings as [[[x, y], ...], ...] in pixels */
+static hsr_status put_rings(FILE *f, const hsr_domain *d)
+{
+    const double S = HSR_SUBPIXEL;
+    double *xy; int *len, nr;
+    hsr_status st = hsr_domain_rings(d, &xy, &len, &nr);
+    if (st != HSR_OK) return st;
+    fputc('[', f);
+    for (int r = 0, off = 0; r < nr; off += len[r], r++) {
+        fprintf(f, "%s[", r ? ", " : "");
+        for (int i = 0; i < len[r]; i++)
+            fprintf(f, "%s[%.17g, %.17g]", i ? ", " : "", xy[2 * (off + i)] / S, xy[2 * (off + i) + 1] / S);
+        fputc(']', f);
+    }
+    fputc(']', f);
+    free(xy); free(len);
+    return HSR_OK;
+}
 
 hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
 {
@@ -24,24 +44,42 @@ hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scen
         if (!hsr_llr_get(h, s, &d, &par, &nv, &np)) continue;
         hsr_plane pl = {0, 0, 0};
         hsr_mlr_get(h, par[0], NULL, &pl, NULL, NULL, NULL);
-        double *xy; int *len, nr;
-        st = hsr_domain_rings(d, &xy, &len, &nr);
-        if (st != HSR_OK) break;
         fprintf(f, "%s\n  {\"mlr\": %d, \"parents\": [", first ? "" : ",", par[0]);
         first = 0;
         for (int i = 0; i < nv; i++) fprintf(f, "%s%d", i ? ", " : "", par[i]);
         fprintf(f, "], \"hidden_parents\": [");
         for (int i = nv; i < np; i++) fprintf(f, "%s%d", i > nv ? ", " : "", par[i]);
-        fprintf(f, "], \"area_px2\": %.17g, \"plane\": [%.17g, %.17g, %.17g],\n   \"rings\": [",
+        fprintf(f, "], \"area_px2\": %.17g, \"plane\": [%.17g, %.17g, %.17g],\n   \"rings\": ",
                 hsr_domain_area(d) / (S * S), pl.a * S, pl.b * S, pl.c);
-        for (int r = 0, off = 0; r < nr; off += len[r], r++) {
-            fprintf(f, "%s[", r ? ", " : "");
-            for (int i = 0; i < len[r]; i++)
-                fprintf(f, "%s[%.17g, %.17g]", i ? ", " : "", xy[2 * (off + i)] / S, xy[2 * (off + i) + 1] / S);
-            fprintf(f, "]");
-        }
-        fprintf(f, "]}");
-        free(xy); free(len);
+        st = put_rings(f, d);
+        fprintf(f, "}");
+    }
+    fprintf(f, "\n]}\n");
+    if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
+    return st;
+}
+
+/* --dump-input: every MLR domain (the projected, clipped, quantised input faces) with id,
+ * opacity, plane and rings, pixel coordinates, y down (schema "hsr-input-1" in
+ * docs/hsr.md; used by sw/tests/test_hsr_oracle.py). */
+hsr_status hsr_write_input_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
+{
+    if (!path || !h || !sc) return HSR_EINVAL;
+    FILE *f = fopen(path, "w");
+    if (!f) return HSR_EIO;
+    const double S = HSR_SUBPIXEL;
+    hsr_status st = HSR_OK;
+    fprintf(f, "{\"format\": \"hsr-input-1\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
+               " \"mlr_count\": %d, \"polygons\": [", HSR_SUBPIXEL, sc->width, sc->height, hsr_mlr_slots(h));
+    for (int id = 0, first = 1; id < hsr_mlr_slots(h) && st == HSR_OK; id++) {
+        const hsr_domain *d; hsr_plane pl; double op;
+        if (!hsr_mlr_get(h, id, &d, &pl, &op, NULL, NULL)) continue;   /* removed (--ops) */
+        fprintf(f, "%s\n  {\"id\": %d, \"opacity\": %.17g, \"area_px2\": %.17g,"
+                   " \"plane\": [%.17g, %.17g, %.17g],\n   \"rings\": ",
+                first ? "" : ",", id, op, hsr_domain_area(d) / (S * S), pl.a * S, pl.b * S, pl.c);
+        st = put_rings(f, d);
+        fprintf(f, "}");
+        first = 0;
     }
     fprintf(f, "\n]}\n");
     if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;

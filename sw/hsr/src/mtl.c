@@ -22,7 +22,7 @@ static int add_file(hsr_scene *sc, const char *path)
 static int colour(char **tok, int nt, double *rgb)
 {
     if (nt != 2 && nt != 4) return 0;
-    for (int c = 0; c < nt - 1; c++) if (!scene_num(tok[1 + c], &rgb[c])) return 0;
+    for (int c = 0; c < nt - 1; c++) if (!hsr_text_num(tok[1 + c], &rgb[c])) return 0;
     if (nt == 2) rgb[1] = rgb[2] = rgb[0];
     return 1;
 }
@@ -30,7 +30,7 @@ static int colour(char **tok, int nt, double *rgb)
 hsr_status scene_mtl_load(hsr_scene *sc, const char *path, const char *where, char *err, size_t errlen)
 {
     char *text;
-    hsr_status st = scene_read_file(path, &text);
+    hsr_status st = hsr_read_text_file(path, &text);
     if (st != HSR_OK) {
         if (err) snprintf(err, errlen, "%s: cannot read MTL file '%s' (%s)", where, path, hsr_status_str(st));
         return st;
@@ -44,7 +44,7 @@ hsr_status scene_mtl_load(hsr_scene *sc, const char *path, const char *where, ch
         lineno++;
 #define FAIL(s_, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", path, lineno); \
         if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } st = s_; goto done; } while (0)
-        int nt = scene_line(&p, buf, sizeof buf, tok, 64);
+        int nt = hsr_text_line(&p, buf, sizeof buf, tok, 64);
         if (nt == -1) FAIL(HSR_EPARSE, "line too long");
         if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
         if (nt == 0) continue;
@@ -72,10 +72,10 @@ hsr_status scene_mtl_load(hsr_scene *sc, const char *path, const char *where, ch
             if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) FAIL(HSR_EPARSE, "'Ks' must be >= 0");
             m->ks = (rgb[0] + rgb[1] + rgb[2]) / 3;
         } else if (!strcmp(k, "Ns")) {
-            if (nt != 2 || !scene_num(tok[1], &v) || v < 0) FAIL(HSR_EPARSE, "'Ns' needs one finite number >= 0");
+            if (nt != 2 || !hsr_text_num(tok[1], &v) || v < 0) FAIL(HSR_EPARSE, "'Ns' needs one finite number >= 0");
             m->shininess = v < 1 ? 1 : v;
         } else {    /* d: opacity, Tr: transparency = 1 - opacity */
-            if (nt != 2 || !scene_num(tok[1], &v) || v < 0 || v > 1) FAIL(HSR_EPARSE, "'%s' needs one number in [0,1]", k);
+            if (nt != 2 || !hsr_text_num(tok[1], &v) || v < 0 || v > 1) FAIL(HSR_EPARSE, "'%s' needs one number in [0,1]", k);
             m->opacity = !strcmp(k, "d") ? v : 1 - v;
         }
 #undef FAIL

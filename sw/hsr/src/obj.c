@@ -38,7 +38,7 @@ int scene_tokens(char *line, char **tok, int max)
     return n;
 }
 
-int scene_line(const char **p, char *buf, size_t cap, char **tok, int max)
+int hsr_text_line(const char **p, char *buf, size_t cap, char **tok, int max)
 {
     const char *e = strchr(*p, '\n');
     size_t n = e ? (size_t)(e - *p) : strlen(*p);
@@ -49,7 +49,7 @@ int scene_line(const char **p, char *buf, size_t cap, char **tok, int max)
     return nt < 0 ? -2 : nt;
 }
 
-int scene_num(const char *s, double *v)
+int hsr_text_num(const char *s, double *v)
 {
     char *end;
     *v = strtod(s, &end);
@@ -99,7 +99,7 @@ hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name, int 
         lineno++;
 #define FAIL(st, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", name, lineno); \
         if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } return st; } while (0)
-        int nt = scene_line(&p, buf, sizeof buf, tok, 512);
+        int nt = hsr_text_line(&p, buf, sizeof buf, tok, 512);
         if (nt == -1) FAIL(HSR_EPARSE, "line too long");
         if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
         if (nt == 0) continue;
@@ -110,7 +110,7 @@ hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name, int 
             if (isn && nt != 4) FAIL(HSR_EPARSE, "'vn' needs 3 numbers");
             if (!isv && !isn && (nt < 2 || nt > 4)) FAIL(HSR_EPARSE, "'vt' needs 1 to 3 numbers");
             for (int i = 1; i < nt; i++)
-                if (!scene_num(tok[i], &x[i - 1])) FAIL(HSR_EPARSE, "bad or non-finite number '%s'", tok[i]);
+                if (!hsr_text_num(tok[i], &x[i - 1])) FAIL(HSR_EPARSE, "bad or non-finite number '%s'", tok[i]);
             if (isv) {
                 if (!add_vec(&sc->v, &sc->nv, &sc->capv, x)) FAIL(HSR_ENOMEM, "too many vertices");
             } else if (isn) {

@@ -38,7 +38,7 @@ static int clip(const double *in, int n, double *out, int axis, double sign, dou
     return m;
 }
 
-int scene_view_make(const hsr_scene *sc, scene_view *vw)
+int hsr_view_make(const hsr_scene *sc, hsr_view *vw)
 {
     sub(sc->eye, sc->at, vw->w);
     cross(sc->up, vw->w, vw->u);
@@ -49,7 +49,7 @@ int scene_view_make(const hsr_scene *sc, scene_view *vw)
     return 1;
 }
 
-int scene_face_cap(const hsr_scene *sc)
+int hsr_face_cap(const hsr_scene *sc)
 {
     int maxn = 4;
     for (int i = 0; i < sc->nf; i++) if (sc->f[i].count > maxn) maxn = sc->f[i].count;
@@ -58,7 +58,7 @@ int scene_face_cap(const hsr_scene *sc)
 
 /* Face fi -> quantised screen polygon q (len points, 0 if clipped away or
  * edge-on) and its depth plane.  a, b: scratch of 3*cap doubles, q: 2*cap. */
-int scene_face_project(const hsr_scene *sc, const scene_view *vw, int fi, double *a, double *b,
+int hsr_face_project(const hsr_scene *sc, const hsr_view *vw, int fi, double *a, double *b,
                        int64_t *q, hsr_plane *plane)
 {
     const hsr_face *F = &sc->f[fi];
@@ -103,15 +103,15 @@ hsr_status hsr_scene_build(const hsr_scene *sc, hsr_ctx **out, double **shade_ou
     if (!sc || !out || !shade_out) return HSR_EINVAL;
     *out = NULL; *shade_out = NULL;
     double L[3];
-    scene_view vw;
+    hsr_view vw;
     memcpy(L, sc->light, sizeof L);
-    if (!scene_view_make(sc, &vw) || !norm(L)) return HSR_EINVAL;
+    if (!hsr_view_make(sc, &vw) || !norm(L)) return HSR_EINVAL;
     double W = vw.W, H = vw.H, S = HSR_SUBPIXEL;
     hsr_config cfg = {{0, 0, (int64_t)(W * S), (int64_t)(H * S)}, sc->grid, sc->grid};
     hsr_ctx *h;
     hsr_status st = hsr_create(&cfg, &h);
     if (st != HSR_OK) return st;
-    int cap = scene_face_cap(sc);
+    int cap = hsr_face_cap(sc);
     double *a = malloc(sizeof(double) * 3 * (size_t)cap), *b = malloc(sizeof(double) * 3 * (size_t)cap);
     int64_t *q = malloc(sizeof(int64_t) * 2 * (size_t)cap);
     double *shade = malloc(sizeof(double) * 4 * (size_t)(sc->nf + 1));
@@ -130,7 +130,7 @@ hsr_status hsr_scene_build(const hsr_scene *sc, hsr_ctx **out, double **shade_ou
         for (int k = 0; k < 3; k++) shade[4 * fi + k] = fmin(1.0, fmax(0.0, m->rgb[k] * lit));
         shade[4 * fi + 3] = m->opacity;
         hsr_plane pl;
-        int len = scene_face_project(sc, &vw, fi, a, b, q, &pl);
+        int len = hsr_face_project(sc, &vw, fi, a, b, q, &pl);
         int id;
         st = hsr_add(h, q, &len, 1, pl, m->opacity, &id);
     }

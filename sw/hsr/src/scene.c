@@ -33,7 +33,7 @@ void hsr_scene_free(hsr_scene *sc)
     free(sc->v); free(sc->fv); free(sc->fvn); free(sc->vn); free(sc->f); free(sc->mat); free(sc);
 }
 
-hsr_status scene_read_file(const char *path, char **text)
+hsr_status hsr_read_text_file(const char *path, char **text)
 {
     *text = NULL;
     FILE *f = fopen(path, "rb");
@@ -62,7 +62,7 @@ hsr_status scene_read_file(const char *path, char **text)
 
 static int nums(char **tok, int n, double *out)
 {
-    for (int i = 0; i < n; i++) if (!scene_num(tok[i], &out[i])) return 0;
+    for (int i = 0; i < n; i++) if (!hsr_text_num(tok[i], &out[i])) return 0;
     return 1;
 }
 
@@ -78,7 +78,7 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
         lineno++;
 #define FAIL(st, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", name, lineno); \
         if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } return st; } while (0)
-        int nt = scene_line(&p, buf, sizeof buf, tok, 64);
+        int nt = hsr_text_line(&p, buf, sizeof buf, tok, 64);
         if (nt == -1) FAIL(HSR_EPARSE, "line too long");
         if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
         if (nt == 0) continue;
@@ -103,9 +103,9 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             if (!(c[9] > 1 && c[9] < 179)) FAIL(HSR_EPARSE, "fov must be in (1, 179) degrees");
             memcpy(sc->eye, c, sizeof sc->eye); memcpy(sc->at, c + 3, sizeof sc->at);
             memcpy(sc->up, c + 6, sizeof sc->up); sc->fov_deg = c[9];
-            /* the same test the projection makes (scene_view_make), here where the line is known */
-            scene_view vw;
-            if (!scene_view_make(sc, &vw))
+            /* the same test the projection makes (hsr_view_make), here where the line is known */
+            hsr_view vw;
+            if (!hsr_view_make(sc, &vw))
                 FAIL(HSR_EPARSE, "%s", c[0] == c[3] && c[1] == c[4] && c[2] == c[5]
                      ? "camera eye and at are the same point: no view direction"
                      : "camera up is zero or parallel to the view direction (eye - at)");
@@ -171,7 +171,7 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
             if (tok[1][0] == '/' || !dir) snprintf(path, sizeof path, "%s", tok[1]);
             else snprintf(path, sizeof path, "%s/%s", dir, tok[1]);
             char *text2;
-            hsr_status st = scene_read_file(path, &text2);
+            hsr_status st = hsr_read_text_file(path, &text2);
             if (st != HSR_OK) FAIL(st, "cannot read OBJ file '%s' (%s)", path, hsr_status_str(st));
             int nf0 = sc->nf;
             st = hsr_obj_parse(sc, text2, path, mat, err, errlen);
@@ -190,7 +190,7 @@ hsr_status hsr_scene_load(const char *path, hsr_scene **out, char *err, size_t e
     if (!path || !out) return HSR_EINVAL;
     *out = NULL;
     char *text;
-    hsr_status st = scene_read_file(path, &text);
+    hsr_status st = hsr_read_text_file(path, &text);
     if (st != HSR_OK) {
         if (err) snprintf(err, errlen, "%s: cannot read (%s)", path, hsr_status_str(st));
         return st;

@@ -20,26 +20,6 @@ int t_add_rect(hsr_ctx *h, int64_t l, int64_t b, int64_t r, int64_t t, double za
     return id;
 }
 
-double t_visible_area(const hsr_ctx *h, int id)
-{
-    double a = 0;
-    for (int s = 0; s < hsr_llr_slots(h); s++) {
-        const hsr_domain *d; const int *par; int nv, np;
-        if (hsr_llr_get(h, s, &d, &par, &nv, &np) && par[0] == id) a += hsr_domain_area(d);
-    }
-    return a;
-}
-
-double t_llr_total_area(const hsr_ctx *h)
-{
-    double a = 0;
-    for (int s = 0; s < hsr_llr_slots(h); s++) {
-        const hsr_domain *d;
-        if (hsr_llr_get(h, s, &d, NULL, NULL, NULL)) a += hsr_domain_area(d);
-    }
-    return a;
-}
-
 static int llr_count(const hsr_ctx *h)
 {
     int c = 0;

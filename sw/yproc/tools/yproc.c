@@ -1,4 +1,4 @@
-/* yproc - command-line front end of sw/hsr.
+/* yproc - command-line front end of sw/hsr and sw/yproc.
  *   yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json]
  *                   [--svg FILE.svg] [--stats] [--ops FILE] [--rebuild]
  * (--ops: incremental operations after the build, yproc_ops.c; --rebuild:
@@ -15,7 +15,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
-#include "hsr.h"
+#include "yproc.h"
 
 int yproc_scan_main(int argc, char **argv);   /* yproc_scan.c */
 int yproc_usage_error(const char *what, const char *arg);
@@ -55,41 +55,6 @@ int yproc_usage_error(const char *what, const char *arg)
     if (what) fprintf(stderr, "yproc: %s%s%s%s\n", what, arg ? " '" : "", arg ? arg : "", arg ? "'" : "");
     fputs(USAGE, stderr);
     return 2;
-}
-
-/* --dump-input: every MLR domain (the projected, clipped, quantised input
- * faces) with id, opacity, plane and rings, pixel coordinates, y down
- * (schema "hsr-input-1" in docs/hsr.md; used by sw/tests/test_hsr_oracle.py). */
-static hsr_status write_input_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
-{
-    FILE *f = fopen(path, "w");
-    if (!f) return HSR_EIO;
-    const double S = HSR_SUBPIXEL;
-    hsr_status st = HSR_OK;
-    fprintf(f, "{\"format\": \"hsr-input-1\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
-               " \"mlr_count\": %d, \"polygons\": [", HSR_SUBPIXEL, sc->width, sc->height, hsr_mlr_slots(h));
-    for (int id = 0, first = 1; id < hsr_mlr_slots(h) && st == HSR_OK; id++) {
-        const hsr_domain *d; hsr_plane pl; double op;
-        if (!hsr_mlr_get(h, id, &d, &pl, &op, NULL, NULL)) continue;   /* removed (--ops) */
-        double *xy = NULL; int *len = NULL, nr = 0;
-        st = hsr_domain_rings(d, &xy, &len, &nr);
-        if (st != HSR_OK) break;
-        fprintf(f, "%s\n  {\"id\": %d, \"opacity\": %.17g, \"area_px2\": %.17g,"
-                   " \"plane\": [%.17g, %.17g, %.17g],\n   \"rings\": [",
-                first ? "" : ",", id, op, hsr_domain_area(d) / (S * S), pl.a * S, pl.b * S, pl.c);
-        for (int r = 0, off = 0; r < nr; off += len[r], r++) {
-            fprintf(f, "%s[", r ? ", " : "");
-            for (int i = 0; i < len[r]; i++)
-                fprintf(f, "%s[%.17g, %.17g]", i ? ", " : "", xy[2 * (off + i)] / S, xy[2 * (off + i) + 1] / S);
-            fprintf(f, "]");
-        }
-        fprintf(f, "]}");
-        free(xy); free(len);
-        first = 0;
-    }
-    fprintf(f, "\n]}\n");
-    if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
-    return st;
 }
 
 static int read_main(int argc, char **argv)
@@ -155,7 +120,7 @@ int main(int argc, char **argv)
     if (json && (st = hsr_write_llr_json(json, h, sc)) != HSR_OK) {
         fprintf(stderr, "%s: cannot write (%s)\n", json, hsr_status_str(st)); rc = 1;
     }
-    if (input && (st = write_input_json(input, h, sc)) != HSR_OK) {
+    if (input && (st = hsr_write_input_json(input, h, sc)) != HSR_OK) {
         fprintf(stderr, "%s: cannot write (%s)\n", input, hsr_status_str(st)); rc = 1;
     }
     if (svg && (st = hsr_write_svg(svg, h, sc, shade)) != HSR_OK) {

@@ -1,7 +1,7 @@
 /* yp_internal.h - private types of the y-processor (yp_*.c). */
 #ifndef YP_INTERNAL_H
 #define YP_INTERNAL_H
-#include "internal.h"
+#include "yproc.h"
 
 #define YP_PIX 4095.0                 /* intensity 1.0 in pixel units */
 #define YP_ONE ((double)(1 << 24))    /* 1 pixel unit in 12.24 */
@@ -11,7 +11,7 @@ struct yp_corner { int v, g, poly, face, c; };
 struct yp_shader {
     const hsr_scene *sc;
     yp_shading mode;
-    scene_view vw;
+    hsr_view vw;
     double *cn;          /* 3 per face corner (sc->fv entry): its normal (unit): the
                           * authored `vn`, else the face normal (`s off`), else the
                           * smooth normal of its vertex in its smoothing group */

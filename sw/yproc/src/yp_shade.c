@@ -130,7 +130,7 @@ void yp_shade_face(const yp_shader *s, int fi, double px, double py, double base
         return;
     }
     /* ray through the pixel position, intersected with the face's plane */
-    const scene_view *vw = &s->vw;
+    const hsr_view *vw = &s->vw;
     double a = (px - vw->W / 2) / vw->f, b = (vw->H / 2 - py) / vw->f, dir[3], P[3];
     for (int k = 0; k < 3; k++) dir[k] = a * vw->u[k] + b * vw->v[k] - vw->w[k];
     const double *n = &s->fn[3 * fi], *p0 = vtx(sc, fi, 0);
@@ -159,7 +159,7 @@ static void face_functions(yp_shader *s, int fi)
     for (int c = 0; c < 3; c++) { g[3 * c] = g[3 * c + 1] = 0; g[3 * c + 2] = base[c]; g[9 + 2 * c] = g[10 + 2 * c] = base[c]; }
     if (sc->f[fi].count < 3) return;
     double xs[3], ys[3], I[3][3];
-    const scene_view *vw = &s->vw;
+    const hsr_view *vw = &s->vw;
     for (int i = 0; i < 3; i++) {
         const double *V = vtx(sc, fi, i);
         double d[3] = {V[0] - sc->eye[0], V[1] - sc->eye[1], V[2] - sc->eye[2]};
@@ -194,7 +194,7 @@ static int corner_cmp(const void *pa, const void *pb)
 hsr_status yp_shader_update(yp_shader *s, const hsr_scene *sc)
 {
     s->sc = sc;
-    if (!scene_view_make(sc, &s->vw)) return HSR_EINVAL;
+    if (!hsr_view_make(sc, &s->vw)) return HSR_EINVAL;
     s->nl = sc->nlights;
     for (int l = 0; l < s->nl; l++) {
         memcpy(s->L[l], sc->lights[l].dir, sizeof s->L[l]);

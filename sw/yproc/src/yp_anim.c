@@ -47,7 +47,7 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
     /* the whole file, then line by line: a line too long for the buffer is an error,
      * not two lines (fgets would split it silently) */
     char *f;
-    hsr_status rs = scene_read_file(path, &f);
+    hsr_status rs = hsr_read_text_file(path, &f);
     if (rs != HSR_OK) { if (err) snprintf(err, errlen, "%s: cannot read (%s)", path, hsr_status_str(rs)); return rs; }
     yp_anim *a = calloc(1, sizeof *a);
     if (!a) { free(f); return HSR_ENOMEM; }
@@ -64,7 +64,7 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
     while (*text) {
         lineno++;
         char *tok[16];
-        int nt = scene_line(&text, line, sizeof line, tok, 16);
+        int nt = hsr_text_line(&text, line, sizeof line, tok, 16);
         if (nt == -1) AFAIL("line too long");
         if (nt < 0) AFAIL("too many items");
         if (nt == 0) continue;
@@ -76,7 +76,7 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
             if (st != HSR_OK) goto fail;
         } else if (!strcmp(tok[0], "frames")) {
             double v;
-            if (nt != 2 || !scene_num(tok[1], &v) || v < 1 || v > 100000 || v != (int)v) AFAIL("'frames N' needs an integer >= 1");
+            if (nt != 2 || !hsr_text_num(tok[1], &v) || v < 1 || v > 100000 || v != (int)v) AFAIL("'frames N' needs an integer >= 1");
             a->frames = (int)v;
         } else if (!strcmp(tok[0], "move") || !strcmp(tok[0], "light") || !strcmp(tok[0], "opacity")) {
             /* move OBJ DX DY DZ from F0 to F1 | light L DX DY DZ from F0 to F1 | opacity MATERIAL A from F0 to F1 */
@@ -87,17 +87,17 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
             action c = {0};
             c.kind = isop ? A_OPACITY : tok[0][0] == 'm' ? A_MOVE : A_LIGHT;
             double fv[2], t;
-            if (!scene_num(tok[3 + nv], &fv[0]) || !scene_num(tok[5 + nv], &fv[1]) || fv[0] < 0 || fv[1] <= fv[0])
+            if (!hsr_text_num(tok[3 + nv], &fv[0]) || !hsr_text_num(tok[5 + nv], &fv[1]) || fv[0] < 0 || fv[1] <= fv[0])
                 AFAIL("frame range must be 0 <= F0 < F1");
             c.f0 = (int)fv[0]; c.f1 = (int)fv[1];
-            for (int i = 0; i < nv; i++) if (!scene_num(tok[2 + i], &c.v[i])) AFAIL("bad number '%s'", tok[2 + i]);
+            for (int i = 0; i < nv; i++) if (!hsr_text_num(tok[2 + i], &c.v[i])) AFAIL("bad number '%s'", tok[2 + i]);
             if (c.kind == A_OPACITY) {
                 c.target = -1;
                 for (int i = 0; i < a->sc->nmat; i++) if (!strcmp(a->sc->mat[i].name, tok[1])) c.target = i;
                 if (c.target < 0) AFAIL("unknown material '%s'", tok[1]);
                 if (!(c.v[0] >= 0 && c.v[0] <= 1)) AFAIL("opacity must be in [0,1]");
             } else {
-                if (!scene_num(tok[1], &t) || t < 0 || t != (int)t) AFAIL("bad index '%s'", tok[1]);
+                if (!hsr_text_num(tok[1], &t) || t < 0 || t != (int)t) AFAIL("bad index '%s'", tok[1]);
                 c.target = (int)t;
                 if (c.kind == A_MOVE && c.target >= a->sc->nobj) AFAIL("object %d does not exist (%d obj lines)", c.target, a->sc->nobj);
                 if (c.kind == A_LIGHT && c.target >= a->sc->nlights) AFAIL("light %d does not exist", c.target);
@@ -187,9 +187,9 @@ hsr_status yp_anim_apply(yp_anim *a, int fr, hsr_ctx *h, yp_shader *sh, int *y0,
         for (int k = 0; k < 3; k++) if (sc->lights[l].dir[k] != old_l[l].dir[k]) lights = 1;
     if (sh) st = yp_shader_update(sh, sc);
     if (h && st == HSR_OK) {
-        scene_view vw;
-        if (!scene_view_make(sc, &vw)) st = HSR_EINVAL;
-        int cap = scene_face_cap(sc);
+        hsr_view vw;
+        if (!hsr_view_make(sc, &vw)) st = HSR_EINVAL;
+        int cap = hsr_face_cap(sc);
         double *ba = malloc(sizeof(double) * 3 * (size_t)cap), *bb = malloc(sizeof(double) * 3 * (size_t)cap);
         int64_t *q = malloc(sizeof(int64_t) * 2 * (size_t)cap);
         if (!ba || !bb || !q) st = HSR_ENOMEM;
@@ -198,7 +198,7 @@ hsr_status yp_anim_apply(yp_anim *a, int fr, hsr_ctx *h, yp_shader *sh, int *y0,
             if (moved[sc->f[fi].obj]) {
                 extent_rows(h, fi, H, &ly0, &ly1);
                 hsr_plane pl;
-                int len = scene_face_project(sc, &vw, fi, ba, bb, q, &pl);
+                int len = hsr_face_project(sc, &vw, fi, ba, bb, q, &pl);
                 st = hsr_move(h, fi, q, &len, 1, pl);
                 extent_rows(h, fi, H, &ly0, &ly1);
             }

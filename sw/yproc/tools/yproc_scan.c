@@ -7,7 +7,7 @@
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
-#include "hsr.h"
+#include "yproc.h"
 
 int yproc_scan_main(int argc, char **argv);
 int yproc_usage_error(const char *what, const char *arg);   /* yproc.c */

@@ -18,7 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "hsr.h"
+#include "yproc.h"
 
 int yproc_apply_ops(hsr_ctx *h, const char *path, double **shade);
 

@@ -471,7 +471,7 @@ static void test_yp_phong_sliver_missing_the_pixel_centre(void)
      * below the base they face the eye and not the light */
     const double vn[9] = {-0.1, -0.3, -0.05, 0.1, -0.3, -0.05, 0, 0.2, -0.4};
     for (int i = 0; i < 9; i++) sh->cn[i] = vn[i];
-    const scene_view *vw = &sh->vw;
+    const hsr_view *vw = &sh->vw;
     /* pixel position of a world point (the inverse of yp_shade_face's ray) */
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, base[3], spec[3];
     double ybase = 0;
