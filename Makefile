@@ -39,7 +39,7 @@ help:
 	@echo "make lint        verilator -Wall and verible lint on every RTL file"
 	@echo "make fpga        yosys + nextpnr: 9-PE chip on ECP5 and iCE40, 640-PE fit, span-serial"
 	@echo "                 array (3 x 648 columns), ULX3S board bitstream (fpga/, docs/fpga.md,"
-	@echo "                 docs/board.md); the folded virtual array: make -C fpga varray"
+	@echo "                 docs/board.md)"
 	@echo "make fpga-board  only the ULX3S bitstream (fpga/ulx3s)"
 	@echo "make postsynth   yosys netlists simulated in Icarus against the golden model"
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
@@ -59,13 +59,13 @@ THREADS ?= 1
 RTL ?= 1
 demo: $(SETUP)
 	@./scripts/ensure_system.sh
-	$(ENV) $(PY) scripts/demo.py --scene $(SCENE) --chips $(CHIPS) --threads $(THREADS) \
+	$(ENV) $(DE) demo --scene $(SCENE) --chips $(CHIPS) --threads $(THREADS) \
 	  --out $(OUT) $(if $(filter 0,$(RTL)),--no-rtl,)
 
 # The shipped animation through incremental frame deltas (out/anim: PNGs and a GIF).
 ANIM ?= sw/scenes/anim/cad_drag.anim
 anim: $(SETUP)
-	$(ENV) $(PY) scripts/anim.py --anim $(ANIM) --out $(OUT)/anim
+	$(ENV) $(DE) anim --anim $(ANIM) --out $(OUT)/anim
 
 # One command file through the golden model (the first demo, before the pipeline).
 demo-cmd: $(SETUP)
@@ -107,11 +107,11 @@ TIER ?= full
 J ?= 2
 sim: $(SETUP)
 	@$(MAKE) -s -C sw/hsr build/yproc
-	$(ENV) cd sw && $(PY) -m diffengine.regress --tier $(TIER) -j $(J) $(if $(SHARD),--shard $(SHARD))
+	$(ENV) $(DE) sim --tier $(TIER) -j $(J) $(if $(SHARD),--shard $(SHARD))
 
 # One report and JUnit file from the shards (SHARDS = their folders, CI: the artifacts).
 sim-merge: $(SETUP)
-	$(ENV) cd sw && $(PY) -m diffengine.regress --merge $(if $(SHARDS),$(abspath $(SHARDS)),$(ROOT)/sim/out/shard-*-of-*)
+	$(ENV) $(DE) sim --merge $(if $(SHARDS),$(abspath $(SHARDS)),$(ROOT)/sim/out/shard-*-of-*)
 
 # The outlier gate (issue 21) at full size: every shipped scene at 640x480 and the public
 # meshes with the 69K-triangle bunny (sw/tests/test_meshes.py; make test runs the shipped
@@ -142,18 +142,18 @@ fpga: $(SETUP)
 	$(MAKE) -C fpga all
 
 bench-hsr: $(SETUP)
-	$(MAKE) -C sw/hsr bench-hsr
+	$(ENV) $(DE) bench hsr --write $(BENCH_ARGS)
 
 bench: $(SETUP)
-	$(ENV) $(PY) scripts/bench_model.py --write
-	$(ENV) $(PY) scripts/bench_yproc.py --write
+	$(ENV) $(DE) bench model --write
+	$(ENV) $(DE) bench yproc --write
 
 # QUICK=1: the 72-chip rates (and the baseline's, when built) and the stream only.
 bench-array: $(SETUP)
-	$(ENV) $(PY) scripts/bench_array.py --write $(if $(filter 1,$(QUICK)),--quick,)
+	$(ENV) $(DE) bench array --write $(if $(filter 1,$(QUICK)),--quick,)
 
 bench-span: $(SETUP)
-	$(ENV) $(PY) scripts/bench_span.py --write
+	$(ENV) $(DE) bench span --write
 
 fpga-board: $(SETUP)
 	$(MAKE) -C fpga/ulx3s

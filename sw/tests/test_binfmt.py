@@ -2,10 +2,11 @@
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from diffengine import binfmt, isa
-from diffengine.asm import AsmError, format_command, parse_text
-from diffengine.binfmt import map_word
-from diffengine.disasm import disassemble, list_slots
+from diffengine.formats import binfmt
+from diffengine import isa
+from diffengine.formats.asm import AsmError, format_command, parse_text
+from diffengine.formats.binfmt import map_word
+from diffengine.formats.disasm import disassemble, list_slots
 from diffengine.isa import Command
 
 M36 = isa.WORD_MASK

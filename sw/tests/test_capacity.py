@@ -1,5 +1,5 @@
 """The capacity model reproduces every entry of Tables 7.3 and 7.4 within 5%."""
-from diffengine import capacity
+from diffengine.model import capacity
 
 
 def test_every_table_entry_within_five_percent():

@@ -6,8 +6,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import binfmt, cli, functional, isa
-from diffengine.asm import parse_file, parse_text
+from diffengine.formats import binfmt
+from diffengine.cli import commands, tree as cli
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.formats.asm import parse_file, parse_text
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 FIG25 = SCENES / "fig7_25.cmd"
@@ -115,7 +118,7 @@ def test_plot(tmp_path, capsys):
 def test_capacity(capsys):
     rc, out, err = run(capsys, "capacity")
     try:
-        import diffengine.capacity  # noqa: F401
+        import diffengine.model.capacity  # noqa: F401
     except ImportError:
         assert rc == 1 and "not available" in err
     else:
@@ -193,7 +196,7 @@ def test_usage_errors(tmp_path, capsys):
 def test_console_script_no_traceback(tmp_path):
     bad = tmp_path / "bad.cmd"
     bad.write_text("Nop;\nEval1 (55, 16, 0.9375.0);\n")
-    p = subprocess.run([sys.executable, "-m", "diffengine.cli", "asm", str(bad)],
+    p = subprocess.run([sys.executable, "-m", "diffengine", "asm", str(bad)],
                        capture_output=True, text=True)
     assert p.returncode == 1
     assert p.stderr == f"{bad}:2: Eval1 I: not a number: '0.9375.0'\n"
@@ -201,7 +204,7 @@ def test_console_script_no_traceback(tmp_path):
 
 def test_model_text_output_table_7_5(tmp_path, capsys):
     """`-o -` prints pixel rows: the Table 7.5 rows of docs/debugging.md."""
-    from diffengine import cli
+    from diffengine.cli import tree as cli
     src = tmp_path / "t75.cmd"
     src.write_text("Eval3 (0, 9, 0x000.000000, 0x000.000000, 0x000.800000);\nRefresh;\n")
     rows = {}
@@ -215,7 +218,7 @@ def test_model_text_output_table_7_5(tmp_path, capsys):
 
 
 def test_encode_subcommand_is_wired(tmp_path):
-    from diffengine import cli
+    from diffengine.cli import tree as cli
     out = tmp_path / "r.cmd"
     assert cli.main(["encode", "/no/such/image.png", "-o", str(out)]) != 0
 
@@ -224,7 +227,7 @@ def test_compare_reports_outliers_and_fails_the_gate(tmp_path, capsys):
     """diffengine compare: a smooth ramp against itself passes; one pixel 0.25 of full
     scale off on the flat part is an outlier (exit 3, map written); a step edge that is
     off by as much is not (the reference is not smooth there)."""
-    from diffengine import frame
+    from diffengine.formats import frame
     ref = np.zeros((12, 16, 3), dtype=np.uint16)
     ref[:] = (np.arange(16) * 8 + 1000)[None, :, None]
     ref[:, 12:] = 3000                                   # an edge at column 12
@@ -238,11 +241,26 @@ def test_compare_reports_outliers_and_fails_the_gate(tmp_path, capsys):
     frame.write_png16(tmp_path / "bad.png", bad)
     m = tmp_path / "map.png"
     rc, out, _ = run(capsys, "compare", tmp_path / "bad.png", tmp_path / "ref.png", "--map", m)
-    assert rc == cli.EXIT_GATE
+    assert rc == commands.EXIT_GATE
     assert "x=4 y=5" in out and "x=12" not in out and m.is_file()
     assert "max 1024.0" in out
     rc, _, _ = run(capsys, "compare", tmp_path / "bad.png", tmp_path / "ref.png",
                    "--max-outliers", "1")
     assert rc == 0
     rc, _, err = run(capsys, "compare", tmp_path / "bad.png", tmp_path / "nope.png")
-    assert rc == cli.EXIT_INPUT and "nope.png" in err
+    assert rc == commands.EXIT_INPUT and "nope.png" in err
+
+
+def test_reference_and_frame_bad_input_name_the_file_without_traceback(tmp_path, capsys):
+    """The subcommands that were module mains (`python -m diffengine.reference/.frame`)
+    report a bad file as `file[:line]: message` with exit 1, as the others do."""
+    scene = tmp_path / "bad.scene"
+    scene.write_text("camera 0 0 0\n")
+    rc, _, err = run(capsys, "reference", scene, "-o", tmp_path / "x.png")
+    assert rc == 1 and f"{scene}:1:" in err and "Traceback" not in err
+    dcf = tmp_path / "bad.dcf"
+    dcf.write_bytes(b"nope")
+    rc, _, err = run(capsys, "frame", dcf, tmp_path / "x.png")
+    assert rc == 1 and f"{dcf}: not a DCF1 frame file" in err
+    rc, _, err = run(capsys, "frame", tmp_path / "missing.dcf", tmp_path / "x.png")
+    assert rc == 1 and "missing.dcf: No such file" in err

@@ -1,6 +1,7 @@
 """The coverage classifier: bins follow docs/isa.md's flag rules, and the report names
 every bin that was not hit."""
-from diffengine import coverage, isa, randgen
+from diffengine.regress import coverage, randgen
+from diffengine import isa
 
 ONE = 1 << 24
 

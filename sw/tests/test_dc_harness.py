@@ -2,7 +2,7 @@
 
 One small build (4 chips = 36 PEs per colour, test mode 32x16 with a 640x480-length
 line of 800 slots, 1 y-processor), shared with test_pipeline.py. Random command streams
-(diffengine.randgen, seed printed, SEED=n replays) per colour, two frames: every frame
+(diffengine.regress.randgen, seed printed, SEED=n replays) per colour, two frames: every frame
 equals functional.render bit for bit, sync/blank are exact, and the Load Monitor's
 registers (read over reg_addr_i by the harness) equal what the streams asked for; an
 overloaded line is late, discarded and counted.
@@ -15,7 +15,11 @@ import random
 import numpy as np
 import pytest
 
-from diffengine import dc_harness as dh, frame, functional, isa, randgen
+from diffengine.rtl import dc_harness as dh
+from diffengine.formats import frame
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
 
 W, H = 32, 16
 CFG = dh.Config(chips=4, num_buf=1, test=(W, 16, 96, 800 - W - 112, H, 1, 2, 2))

@@ -9,10 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import encode as EN
-from diffengine import encode_raster as ER
-from diffengine import encode_spline as ES
-from diffengine import functional, isa
+from diffengine.cli import main as cli_main
+from diffengine.encode import image as EN
+from diffengine.encode import raster as ER
+from diffengine.encode import spline as ES
+from diffengine.model import functional
+from diffengine import isa
 
 IMAGES = Path(__file__).resolve().parents[1] / "images"
 
@@ -42,7 +44,7 @@ def test_all_coefficients_kept_natural_psnr_50(natural, d):
 
 @pytest.fixture(scope="module")
 def teapot():
-    # the project's rendered teapot frame (scripts/make_test_images.py -> demo.py): the
+    # the project's rendered teapot frame (diffengine bench recon-images -> demo.py): the
     # most natural image it can ship (smooth Phong shading, anti-aliased silhouettes)
     return EN.load_image(IMAGES / "teapot.png")
 
@@ -251,10 +253,10 @@ def test_cli_roundtrip(tmp_path):
     out = tmp_path / "nat.cmd"
     src = tmp_path / "small.png"
     EN.save_png16(src, crop("natural", rows=8, cols=64))
-    rc = EN.encode_main([str(src), "-o", str(out), "--psnr", "42", "--baselines",
+    rc = cli_main(["encode", str(src), "-o", str(out), "--psnr", "42", "--baselines",
                          "--preview", str(tmp_path / "dec.png"), "--de48"])
     assert rc == 0
-    from diffengine.asm import parse_file
+    from diffengine.formats.asm import parse_file
     cmds = parse_file(out)
     dec = functional.render(cmds, 64).astype(np.int64)
     assert ES.psnr(dec, EN.load_image(src)) >= 42.0
@@ -265,13 +267,13 @@ def test_cli_roundtrip(tmp_path):
 def test_cli_colour_three_streams(tmp_path):
     src = tmp_path / "c.png"
     EN.save_png16(src, EN.load_image(IMAGES / "spheres.png")[50:58, 40:100])
-    assert EN.encode_main([str(src), "-o", str(tmp_path / "s.cmd"), "--psnr", "40"]) == 0
+    assert cli_main(["encode", str(src), "-o", str(tmp_path / "s.cmd"), "--psnr", "40"]) == 0
     for c in "rgb":
         assert (tmp_path / f"s.{c}.cmd").exists()
 
 
 def _err(capsys, argv):
-    rc = EN.encode_main(argv)
+    rc = cli_main(["encode", *argv])
     return rc, capsys.readouterr().err
 
 

@@ -13,8 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import asm, isa
-from diffengine import functional as F
+from diffengine.formats import asm
+from diffengine import isa
+from diffengine.model import functional as F
 
 W = 130
 FIG = {

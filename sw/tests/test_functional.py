@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from diffengine import functional as F
+from diffengine.model import functional as F
 from diffengine import isa
 from diffengine.isa import Command as C
 

@@ -18,8 +18,9 @@ import random
 import numpy as np
 import pytest
 
-from diffengine import functional as F
-from diffengine import isa, randgen
+from diffengine.model import functional as F
+from diffengine import isa
+from diffengine.regress import randgen
 
 C = isa.Command
 EXTREMES = [-(1 << 35), (1 << 35) - 1, -1, 1, (1 << 24) - 1, -(1 << 24), 0x7FFFFF]
@@ -107,7 +108,7 @@ def test_batch_matches_on_randgen_streams():
 
 
 def test_bench_mixed_frame_rows():
-    """A few lines of the benchmark's mixed frame (scripts/bench_model.py), as they are."""
+    """A few lines of the benchmark's mixed frame (diffengine bench model), as they are."""
     seed = _seed(0xB3)
     print(f"test_bench_mixed_frame_rows seed {seed}")
     rng = np.random.default_rng(seed)

@@ -4,8 +4,9 @@ import re
 
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from diffengine import binfmt, isa
-from diffengine.asm import AsmError, format_command, parse_text
+from diffengine.formats import binfmt
+from diffengine import isa
+from diffengine.formats.asm import AsmError, format_command, parse_text
 from test_binfmt import commands_st
 
 NAME = "fz.cmd"

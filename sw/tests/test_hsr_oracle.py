@@ -71,7 +71,7 @@ import shapely
 from shapely.geometry import LineString, Point, Polygon, box
 from shapely.ops import polygonize, unary_union
 
-from diffengine import yproc as yproc_tool
+from diffengine.host import yproc as yproc_tool
 
 ROOT = Path(__file__).resolve().parents[2]
 HSR = ROOT / "sw" / "hsr"

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from diffengine import pipeline
+from diffengine.pipeline import demo as pipeline
 from scene_files import scene_copy
 
 REPO = Path(__file__).resolve().parents[2]
@@ -80,7 +80,7 @@ def test_gate_sees_a_planted_outlier(tmp_path):
     scale too bright, is counted (and nothing else is)."""
     import numpy as np
 
-    from diffengine import reference
+    from diffengine.model import reference
 
     scene = _resized(MESHES / "spot.scene", tmp_path, 4)      # 160x120: a fast reference
     rep = pipeline.run(scene, tmp_path, rtl=False, show_progress=False, log=lambda *a: None)

@@ -17,7 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import pipeline, reference, yproc
+from diffengine.pipeline import demo as pipeline
+from diffengine.model import reference
+from diffengine.host import yproc
 
 REPO = Path(__file__).resolve().parents[2]
 OBJ = REPO / "sw/hsr/tests/obj"

@@ -1,4 +1,4 @@
-"""The whole `make demo` pipeline on tiny screens (diffengine.pipeline, scripts/demo.py).
+"""The whole `make demo` pipeline on tiny screens (diffengine.pipeline.demo, `diffengine demo`).
 
 Scenes: the shipped CAD scene (transparent glass, specular, flat, interpenetrating) and
 the Phong teapot, re-framed to a 32x16 screen; 4 chips (36 PEs) per colour, the
@@ -18,7 +18,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import anim, dc_harness, frame, functional, pipeline, reference
+from diffengine.pipeline import anim, demo as pipeline
+from diffengine.rtl import dc_harness
+from diffengine.formats import frame
+from diffengine.model import functional, reference
 from scene_files import scene_copy
 
 REPO = Path(__file__).resolve().parents[2]
@@ -144,7 +147,7 @@ def test_animation_deltas_equal_full_rerender(tmp_path):
 
 
 def test_demo_cli_help_mentions_chips():
-    res = subprocess.run([sys.executable, str(REPO / "scripts/demo.py"), "--help"],
+    res = subprocess.run([sys.executable, "-m", "diffengine", "demo", "--help"],
                          capture_output=True, text=True)
     assert res.returncode == 0 and "smaller screen" in res.stdout.replace("\n", " ") or \
         "9*CHIPS" in res.stdout

@@ -4,7 +4,10 @@ frame, so the scoreboard may model and compare a 10^7-command stream piece by pi
 import numpy as np
 import pytest
 
-from diffengine import binfmt, functional, isa, randgen
+from diffengine.formats import binfmt
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
 
 
 @pytest.mark.parametrize("chunk", [1, 50, 700, 10**6])

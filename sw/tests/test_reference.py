@@ -1,4 +1,4 @@
-"""The numpy reference renderer (diffengine.reference) against closed forms.
+"""The numpy reference renderer (diffengine.model.reference) against closed forms.
 
 Tiny analytic scenes: a flat square facing the camera (exact colour inside, exact area
 fraction on its edge and corner pixels), a quad with a sphere-like normal field (vn) vs
@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import reference as ref
-from diffengine import yproc
+from diffengine.model import reference as ref
+from diffengine.host import yproc
 
 S = 4095.0
 

@@ -11,8 +11,9 @@ import random
 import numpy as np
 import pytest
 
-from diffengine import functional, isa
-from diffengine import structural as st
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.model import structural as st
 
 
 def _seed(salt: int) -> int:

@@ -7,7 +7,8 @@ isa.compensate (ddI becomes 0x000.400000).
 """
 import pytest
 
-from diffengine import functional, isa
+from diffengine.model import functional
+from diffengine import isa
 
 # (dI, I) rows, copied from the source as printed: correct | erroneous | compensated
 TABLE_7_5 = """
@@ -57,7 +58,8 @@ def test_table_7_5_structural(pair, bug, comp):
     data mapper's (binfmt.compensate_slots, what the prototype's mapper does to the
     serialised slots in front of the array), so the fault and its repair meet exactly
     where they do in hardware."""
-    from diffengine import binfmt, structural
+    from diffengine.formats import binfmt
+    from diffengine.model import structural
 
     slots = isa.serialise([isa.Command("EVAL", 0, 9, (0, 0, DDI))])
     if comp:

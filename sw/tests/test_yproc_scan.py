@@ -21,7 +21,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 import yproc_common as yc  # noqa: E402
 
-from diffengine import asm  # noqa: E402
+from diffengine.formats import asm  # noqa: E402
 
 W, H = 64, 48
 TOL = 1.0

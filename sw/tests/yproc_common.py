@@ -9,7 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from diffengine import binfmt, functional, isa
+from diffengine.formats import binfmt
+from diffengine.model import functional
+from diffengine import isa
 
 ROOT = Path(__file__).resolve().parents[2]
 HSR = ROOT / "sw" / "hsr"

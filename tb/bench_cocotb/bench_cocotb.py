@@ -1,5 +1,5 @@
 """cocotb overhead benchmark (not a test: the file name keeps it out of `make test`;
-scripts/bench_array.py runs it explicitly). Drives a random stream into de_array, one
+diffengine bench array runs it explicitly). Drives a random stream into de_array, one
 instruction per clock, with no checking, and prints the simulated cycles per second."""
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import RisingEdge
 
-from diffengine import isa, randgen
+from diffengine import isa
+from diffengine.regress import randgen
 
 
 @cocotb.test()
@@ -42,11 +43,9 @@ async def drive_stream(dut):
 
 
 def test_bench_cocotb():
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
-            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
-            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv"]
+    srcs = rtl_files("array", "sim")
     build_and_test(here, "de_array", srcs, "bench_cocotb",
                    parameters={"NumChips": int(os.environ.get("BENCH_CHIPS", 1)),
                                "CarryBug": 0},

@@ -49,7 +49,10 @@ sys.path.insert(0, str(HERE.parent.parent / "fpga" / "ulx3s"))
 import tmds  # noqa: E402
 # The host tool's command encoders: the test checks them against the RTL too.
 from de32_load import cmd_p, cmd_w, with_chk  # noqa: E402
-from diffengine import binfmt, functional, isa, randgen  # noqa: E402
+from diffengine.formats import binfmt  # noqa: E402
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
 
 NCH = 3
 
@@ -518,17 +521,8 @@ BOARD = dict(NumChips=1, CarryBug=1, FsDepth=256, ClkPerBit=8, TimeoutBits=11,
 
 
 def board_sources():
-    from common.run import RTL
-    return [RTL / p for p in (
-        "xproc/de_pkg.sv", "xproc/de_pe.sv", "proto/de_skew.sv", "proto/de_deskew.sv",
-        "proto/de_instr_lut.sv", "proto/de_data_mapper.sv", "array/de_chip.sv",
-        "array/de_array.sv", "ctrl/de_instr_buffer.sv", "ctrl/de_video_timing.sv",
-        "ctrl/de_access_ctrl.sv", "ctrl/de_load_monitor.sv", "ctrl/de_display_core.sv",
-        "ctrl/display_controller.sv", "board/de_uart_rx.sv", "board/de_uart_tx.sv",
-        "board/de_loader.sv", "board/de_fs_player.sv", "board/de_tmds_enc.sv",
-        "board/de_board_core.sv", "varray/de_span_array.sv", "varray/de_afifo.sv",
-        "varray/de_skid.sv",
-        "varray/de_span_video.sv")]
+    from common.run import rtl_files
+    return rtl_files("board")
 
 
 def test_tmds():
@@ -550,7 +544,6 @@ def test_board(span):
 def test_shell():
     """The ULX3S shell with stand-in PLL/ODDR models (core defaults: 1 chip, mode 0)."""
     from common.run import build_and_test
-    build_and_test(HERE, "ulx3s_top",
-                   board_sources() + [HERE / "ecp5_models.sv",
-                                      HERE.parent.parent / "fpga" / "ulx3s" / "ulx3s_top.sv"],
+    from common.run import rtl_files
+    build_and_test(HERE, "ulx3s_top", rtl_files("diffengine:tb:board_top"),
                    "test_board_top", testcase="test_shell_serialiser")

@@ -13,6 +13,20 @@ REPO = Path(__file__).resolve().parents[2]
 RTL = REPO / "rtl"
 
 
+def rtl_files(core: str, target: str = "default") -> list[Path]:
+    """The ordered file list of a FuseSoC core and target (rtl/*/*.core, tb/*/*.core),
+    e.g. rtl_files("array") or rtl_files("diffengine:tb:de_pe"): scripts/filelist.py."""
+    import importlib.util
+    mod = sys.modules.get("filelist")
+    if mod is None:
+        spec = importlib.util.spec_from_file_location("filelist",
+                                                      REPO / "scripts" / "filelist.py")
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules["filelist"] = mod
+        spec.loader.exec_module(mod)
+    return mod.files(core, target)
+
+
 def build_and_test(tb_dir: Path, toplevel: str, sources: list[Path], test_module: str,
                    parameters: dict | None = None, extra_env: dict | None = None,
                    testcase: str | None = None, waves: bool = False) -> None:

@@ -351,6 +351,7 @@ async def test_random_vs_model(dut):
 
 def _build_and_run(num_buf: int, latency: int, all_modes: bool):
     from cocotb_tools.runner import get_runner
+    from common.run import rtl_files
 
     sys.path.insert(0, str(HERE))
     seed = get_seed()
@@ -359,7 +360,7 @@ def _build_and_run(num_buf: int, latency: int, all_modes: bool):
     build_dir = HERE / f"sim_build_NumBuf{num_buf}_Lat{latency}"
     params = {"NumBuf": num_buf, "ArrayLatency": latency}
     runner.build(
-        sources=[ROOT / "rtl/ctrl/de_video_timing.sv", ROOT / "rtl/ctrl/de_access_ctrl.sv"],
+        sources=rtl_files("display_core", "access_ctrl"),
         hdl_toplevel="de_access_ctrl",
         parameters=params,
         build_dir=build_dir,

@@ -21,8 +21,10 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from diffengine import functional, isa, randgen
-from diffengine import structural as st
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
+from diffengine.model import structural as st
 
 NUM_PE = 9
 FAULTY = (3, 10)  # PEs garbled by the FaultMask build (bypass test)
@@ -251,7 +253,7 @@ async def table_7_5_through_the_mapper(dut):
     (binfmt.map_word, against which rtl/proto/de_data_mapper.sv is tested), with
     compensation when the array has the fault. Registers B (dI) and A (I) of PEs 0..8
     match the source's correct or compensated columns digit for digit."""
-    from diffengine import binfmt
+    from diffengine.formats import binfmt
     arr = await start(dut)
     bug = carry_bug(dut)
     cmd = isa.Command("EVAL", 0, 9, (0, 0, 1 << 23))  # ddI = 0x000.800000
@@ -300,11 +302,9 @@ RUNS = [  # (chips, carry_bug, faulty)
 @pytest.mark.parametrize("chips,bug,faulty", RUNS,
                          ids=[f"chips{c}_bug{b}_faulty{f}" for c, b, f in RUNS])
 def test_de_array(chips, bug, faulty):
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
-            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
-            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv"]
+    srcs = rtl_files("array", "sim")
     mask = sum(1 << q for q in FAULTY) if faulty else 0
     params = {"NumChips": chips, "CarryBug": bug}
     if faulty:

@@ -24,7 +24,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import binfmt, coverage, functional, harness, isa, randgen
+from diffengine.formats import binfmt
+from diffengine.regress import coverage, randgen
+from diffengine.model import functional
+from diffengine.rtl import harness
+from diffengine import isa
 
 N_COMMANDS = int(os.environ.get("N_COMMANDS", 100_000))
 CHUNK = 200_000

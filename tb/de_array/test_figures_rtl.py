@@ -9,7 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import asm, functional, harness, isa
+from diffengine.formats import asm
+from diffengine.model import functional
+from diffengine.rtl import harness
+from diffengine import isa
 
 SCENES = Path(__file__).resolve().parents[2] / "sw" / "scenes"
 FILES = sorted(p.name for p in SCENES.glob("fig7_*.cmd"))

@@ -1,4 +1,4 @@
-"""The prototype input circuit against the golden model (diffengine.binfmt.map_word).
+"""The prototype input circuit against the golden model (diffengine.formats.binfmt.map_word).
 
 driver: random frame-store words (every LUT code, random operands, windows 0..4,
 compensation on/off) one per clock -> monitor: mapper output one clock later, the
@@ -13,7 +13,7 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from diffengine.binfmt import map_word
+from diffengine.formats.binfmt import map_word
 
 N_WORDS = 4000
 
@@ -68,9 +68,7 @@ async def mapper_matches_model(dut):
 
 
 def test_de_input_circuit():
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    srcs = [RTL / "proto" / f for f in
-            ("de_instr_lut.sv", "de_data_mapper.sv", "de_skew.sv", "de_deskew.sv")]
-    build_and_test(here, "de_input_circuit_tb", srcs + [here / "de_input_circuit_tb.sv"],
+    build_and_test(here, "de_input_circuit_tb", rtl_files("diffengine:tb:de_input_circuit"),
                    "test_de_input_circuit")

@@ -8,7 +8,7 @@ Structure (like cocotb's matrix_multiplier example):
   Driver   - drives one instruction per clock at the falling edge (Nop when idle).
   Monitor  - after each rising edge (ReadOnly) samples the inputs that were clocked in
              and every PE's state (dbg_o) and pixel outputs.
-  Model    - sw/diffengine/structural.py Array, stepped with the sampled inputs.
+  Model    - sw/diffengine/model/structural.py Array, stepped with the sampled inputs.
   Checker  - in order: the RTL state after edge k must equal the model after step k,
              every field of every PE, every cycle.
 
@@ -29,8 +29,9 @@ TB_DIR = Path(__file__).resolve().parent
 ROOT = TB_DIR.parent.parent
 sys.path.insert(0, str(ROOT / "sw"))
 
-from diffengine import functional, isa  # noqa: E402
-from diffengine import structural as st  # noqa: E402
+from diffengine.model import functional  # noqa: E402
+from diffengine import isa
+from diffengine.model import structural as st  # noqa: E402
 
 try:  # the pytest runner does not need a simulator; the cocotb part does
     import cocotb
@@ -399,8 +400,8 @@ async def table_7_5(dut):
 # ---- pytest runner --------------------------------------------------------------------------
 
 def _sources() -> list[Path]:
-    return [ROOT / "rtl/xproc/de_pkg.sv", ROOT / "rtl/xproc/de_pe.sv",
-            TB_DIR / "de_pe_chain.sv"]
+    from common.run import rtl_files   # tb/de_pe/de_pe_tb.core
+    return rtl_files("diffengine:tb:de_pe")
 
 
 def _run(carry_bug: int, n_pe: int = 9) -> None:

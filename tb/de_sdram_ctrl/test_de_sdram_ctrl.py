@@ -30,7 +30,6 @@ from collections import deque
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent.parent
 sys.path.insert(0, str(HERE.parent))
 
 try:
@@ -228,12 +227,11 @@ try:
 
     @pytest.mark.parametrize("build", list(BUILDS))
     def test_de_sdram_ctrl(build):
-        from common.run import RTL, build_and_test
+        from common.run import build_and_test, rtl_files
         tck, cl = BUILDS[build]
-        build_and_test(HERE, "tb_sdram_ctrl",
-                       [RTL / "board" / "de_sdram_ctrl.sv",
-                        ROOT / "sim" / "models" / "sdram_sdr16.sv", HERE / "tb_sdram_ctrl.sv"],
-                       "test_de_sdram_ctrl", parameters={"TckPs": tck, "CasLatency": cl},
+        srcs = rtl_files("diffengine:tb:de_sdram_ctrl")   # tb/de_sdram_ctrl/de_sdram_ctrl_tb.core
+        build_and_test(HERE, "tb_sdram_ctrl", srcs, "test_de_sdram_ctrl",
+                       parameters={"TckPs": tck, "CasLatency": cl},
                        extra_env={"SDRAM_TCK": str(tck), "SDRAM_CL": str(cl)})
 except ImportError:  # pragma: no cover
     pass

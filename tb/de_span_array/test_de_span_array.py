@@ -19,7 +19,10 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 
-from diffengine import asm, functional, isa, randgen, structural
+from diffengine.formats import asm
+from diffengine.model import functional, structural
+from diffengine import isa
+from diffengine.regress import randgen
 
 SCENES = Path(__file__).resolve().parents[2] / "sw" / "scenes"
 ONE = 1 << isa.FRAC_BITS
@@ -292,7 +295,7 @@ async def stream_file(dut):
     """A whole .de48 frame (DE_SPAN_STREAM) as fast as the array takes it: the frame must
     equal the functional model, and the clocks each line took go to DE_SPAN_OUT (JSON)."""
     import json
-    from diffengine import binfmt
+    from diffengine.formats import binfmt
     path = Path(os.environ["DE_SPAN_STREAM"])
     slots = binfmt.decode_de48(path.read_bytes(), str(path))
     cmds = binfmt.deserialise(slots, str(path))
@@ -332,7 +335,7 @@ async def stream_file(dut):
 # per Eval3; 2 slots per pass splits every Eval into 2-5 passes, with the carry fault;
 # 130 columns take the figure lists whole.
 RUNS = [(37, 4, 0), (37, 2, 1), (130, 9, 0)]
-if os.environ.get("DE_SPAN_STREAM"):   # scripts/bench_span.py: one full-width build
+if os.environ.get("DE_SPAN_STREAM"):   # diffengine bench span: one full-width build
     RUNS = [(int(os.environ.get("DE_SPAN_COLS", 648)),
              int(os.environ.get("DE_SPAN_SLOTS", 4)), 0)]
 
@@ -340,10 +343,9 @@ if os.environ.get("DE_SPAN_STREAM"):   # scripts/bench_span.py: one full-width b
 @pytest.mark.parametrize("cols,slots,bug", RUNS,
                          ids=[f"cols{c}_slots{s}_bug{b}" for c, s, b in RUNS])
 def test_de_span_array(cols, slots, bug):
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    build_and_test(here, "de_span_array",
-                   [RTL / "xproc" / "de_pkg.sv", RTL / "varray" / "de_span_array.sv"],
+    build_and_test(here, "de_span_array", rtl_files("span_array", "sim"),
                    "test_de_span_array",
                    parameters={"NumCols": cols, "MaxSlots": slots, "CarryBug": bug},
                    extra_env={"DE_CARRY_BUG": str(bug)},

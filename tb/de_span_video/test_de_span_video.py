@@ -21,7 +21,9 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 
-from diffengine import functional, isa, randgen
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
 
 PIX_PS = 40000
 
@@ -115,14 +117,9 @@ RUNS = [(2, 60, 0), (2, 60, 1), (2, 6, 0)]
 @pytest.mark.parametrize("chips,lat,bug", RUNS,
                          ids=[f"chips{c}_lat{la}_bug{b}" for c, la, b in RUNS])
 def test_de_span_video(chips, lat, bug):
-    from common.run import RTL, build_and_test
+    from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
-            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
-            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv",
-            RTL / "varray" / "de_span_array.sv", RTL / "varray" / "de_afifo.sv",
-            RTL / "varray" / "de_skid.sv",
-            RTL / "varray" / "de_span_video.sv", here / "tb_de_span_video.sv"]
+    srcs = rtl_files("diffengine:tb:de_span_video")   # tb/de_span_video/de_span_video_tb.core
     build_and_test(here, "tb_de_span_video", srcs, "test_de_span_video",
                    parameters={"NumChips": chips, "Latency": lat, "CarryBug": bug},
                    extra_env={"DE_CARRY_BUG": str(bug)},

@@ -41,7 +41,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE.parent.parent / "sw"))
 
-from diffengine import functional, isa, randgen  # noqa: E402
+from diffengine.model import functional  # noqa: E402
+from diffengine import isa
+from diffengine.regress import randgen
 
 NCH = 3
 REFRESH_ID = 0x100
@@ -547,16 +549,8 @@ RUNS = {
 
 @pytest.mark.parametrize("name", list(RUNS))
 def test_display_controller(name):
-    from common.run import RTL, build_and_test
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "xproc" / "de_pe.sv",
-            RTL / "proto" / "de_skew.sv", RTL / "proto" / "de_deskew.sv",
-            RTL / "array" / "de_chip.sv", RTL / "array" / "de_array.sv",
-            RTL / "ctrl" / "de_instr_buffer.sv", RTL / "ctrl" / "de_video_timing.sv",
-            RTL / "ctrl" / "de_access_ctrl.sv", RTL / "ctrl" / "de_load_monitor.sv",
-            RTL / "ctrl" / "de_display_core.sv", RTL / "ctrl" / "display_controller.sv",
-            RTL / "varray" / "de_span_array.sv", RTL / "varray" / "de_afifo.sv",
-            RTL / "varray" / "de_skid.sv",
-            RTL / "varray" / "de_span_video.sv"]
+    from common.run import build_and_test, rtl_files
+    srcs = rtl_files("display_controller", "sim")
     build_and_test(HERE, "display_controller", srcs, "test_display_controller",
                    parameters=RUNS[name],
                    extra_env={"DE_UTIL_OUT": str(HERE / "sim_build_util" / f"{name}.txt")})

@@ -9,7 +9,6 @@ Not in `make test` (a fresh run synthesises: ~1.5 min of yosys per netlist): run
 
 Netlists (built once into tb/postsynth/sim_build_net_*/, redone when a source changes):
   de_array  NumChips=1 (9 columns)          yosys `synth -flatten` (generic gates)
-  de_varray NumChips=1 Fold=3 (3 phys PEs)  yosys `synth -flatten` (generic gates)
   de_span_array NumCols=37 MaxSlots=2       yosys `synth -flatten` (generic gates; the
                                             state banks and pass table stay memories:
                                             the ECP5 DP16KD model is a black box)
@@ -37,11 +36,12 @@ from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 SCENES = REPO / "sw" / "scenes"
-RTL = REPO / "rtl"
 
 
 def stream(n: int):
-    from diffengine import asm, isa, randgen
+    from diffengine.formats import asm
+    from diffengine import isa
+    from diffengine.regress import randgen
     from de_array.test_de_array import spaced
     seed = int(os.environ.get("SEED", random.randrange(1 << 31)))
     cocotb.log.info(f"SEED={seed} (replay with SEED={seed})")
@@ -54,7 +54,7 @@ def stream(n: int):
 @cocotb.test()
 async def netlist_frames(dut):
     """Play the stream into the netlist; the pixels form the golden model's frame."""
-    from diffengine import functional
+    from diffengine.model import functional
     fold = int(os.environ.get("DE_FOLD", "0"))   # 0: plain array (one slot per clock)
     bug = bool(int(os.environ.get("DE_CARRY_BUG", "0")))
     cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
@@ -91,7 +91,9 @@ async def span_netlist_frames(dut):
     """The span-serial array's netlist: a random stream and the figure lists (the
     columns that fit) through the valid/ready port equal the golden model."""
     from de_span_array.test_de_span_array import start
-    from diffengine import asm, isa, randgen
+    from diffengine.formats import asm
+    from diffengine import isa
+    from diffengine.regress import randgen
     n = int(os.environ["DE_SPAN_COLS"])
     seed = int(os.environ.get("SEED", random.randrange(1 << 31)))
     dut._log.info(f"SEED={seed} (replay with SEED={seed})")
@@ -106,8 +108,6 @@ async def span_netlist_frames(dut):
 
 
 # ---- netlists and runners ----------------------------------------------------------------
-ARRAY_SRCS = ["xproc/de_pkg.sv", "xproc/de_pe.sv", "proto/de_skew.sv", "proto/de_deskew.sv",
-              "array/de_chip.sv", "array/de_array.sv"]
 
 
 def netlist(top: str, params: dict, srcs: list[Path], tag: str, ecp5: bool = False) -> Path:
@@ -175,23 +175,15 @@ TIER = pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH", "0")),
 
 @TIER
 def test_postsynth_array():
-    net = netlist("de_array", {"NumChips": 1}, [RTL / s for s in ARRAY_SRCS], "array1")
+    from common.run import rtl_files
+    net = netlist("de_array", {"NumChips": 1}, rtl_files("array"), "array1")
     run("de_array", [net], "array1", {"DE_FOLD": "0"})
 
 
 @TIER
-def test_postsynth_varray():
-    sys.path.insert(0, str(RTL / "varray"))
-    from gen_vpe import ensure
-    vpe = ensure(HERE / "sim_build_gen" / "de_vpe.sv")
-    srcs = [RTL / "xproc" / "de_pkg.sv", vpe, RTL / "varray" / "de_varray.sv"]
-    net = netlist("de_varray", {"NumChips": 1, "Fold": 3}, srcs, "varray1_f3")
-    run("de_varray", [net], "varray1_f3", {"DE_FOLD": "3"})
-
-
-@TIER
 def test_postsynth_span():
-    srcs = [RTL / "xproc" / "de_pkg.sv", RTL / "varray" / "de_span_array.sv"]
+    from common.run import rtl_files
+    srcs = rtl_files("span_array", "sim")
     net = netlist("de_span_array", {"NumCols": 37, "MaxSlots": 2}, srcs, "span37_s2")
     run("de_span_array", [net], "span37_s2", {"DE_SPAN_COLS": "37"},
         testcase="span_netlist_frames")
@@ -201,6 +193,7 @@ def test_postsynth_span():
                     reason="tier: make -C fpga postsynth-ecp5 (DE_POSTSYNTH_ECP5=1)")
 def test_postsynth_array_ecp5_cells():
     cells = ecp5_cell_models()
-    net = netlist("de_array", {"NumChips": 1}, [RTL / s for s in ARRAY_SRCS], "array1_ecp5",
+    from common.run import rtl_files
+    net = netlist("de_array", {"NumChips": 1}, rtl_files("array"), "array1_ecp5",
                   ecp5=True)
     run("de_array", [cells, net], "array1_ecp5", {"DE_FOLD": "0"}, simulator="icarus")

@@ -2,7 +2,7 @@
 command files decode bit-identically in the RTL and in the golden model.
 
 Two kinds of case, all on the cached 8-chip harness build (72 columns, sim/build via
-diffengine.harness):
+diffengine.rtl.harness):
 
 * 72x12 crops of the 256-wide test images, channel 0 (one per codec);
 * the whole 72x54 colour image `tiny_rgb.png` (the rendered teapot frame, reduced), all
@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import encode as EN
-from diffengine import functional
+from diffengine.encode import image as EN
+from diffengine.model import functional
 
 REPO = Path(__file__).resolve().parents[2]
 WIDTH = 72  # 8 chips: the build is shared with the array scoreboard

@@ -38,7 +38,6 @@ try:  # the pytest runner part does not need cocotb's simulator side
 except ImportError:  # pragma: no cover
     cocotb = None
 
-MODEL = ROOT / "sim" / "models" / "sdram_sdr16.sv"
 
 # Error codes of the model (err_code_o, err_seen_o bit).
 CODES = {"INIT": 1, "TRCD": 2, "TRP": 3, "TRAS": 4, "TRAS_MAX": 5, "TRC": 6, "TRRD": 7,
@@ -615,7 +614,9 @@ def _run(build: str) -> None:
     runner = get_runner("verilator")
     # As tb/common/run.py's build_and_test (ccache through OBJCACHE, tb/conftest.py), plus
     # the +sdram_log plusarg that it has no argument for.
-    runner.build(sources=[str(MODEL)], hdl_toplevel="sdram_sdr16", parameters=params,
+    from common.run import rtl_files
+    srcs = [str(f) for f in rtl_files("diffengine:sim:sdram_sdr16")]   # sim/models/sdram_sdr16.core
+    runner.build(sources=srcs, hdl_toplevel="sdram_sdr16", parameters=params,
                  build_dir=build_dir,
                  build_args=["-Wno-fatal", "-MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include"])
     env = dict(env, SDRAM_LOG=str(log),

@@ -23,7 +23,10 @@ REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "sw"))
 sys.path.insert(0, str(REPO / "scripts"))
 
-from diffengine import binfmt, functional, harness, isa, structural, trace  # noqa: E402
+from diffengine.formats import binfmt  # noqa: E402
+from diffengine.model import functional, structural
+from diffengine.rtl import harness, trace
+from diffengine import isa
 
 CHIPS = 2
 N_PE = 9 * CHIPS
@@ -175,7 +178,7 @@ def test_compare_finds_the_table_7_5_carry_fault(tmp_path):
     cmd = tmp_path / "t75.cmd"
     cmd.write_text(T75)
     env = dict(os.environ, PYTHONPATH=str(REPO / "sw"))
-    base = [sys.executable, "-c", "import sys; from diffengine.cli import main; "
+    base = [sys.executable, "-c", "import sys; from diffengine.cli.tree import main; "
             "sys.exit(main(sys.argv[1:]))", "trace", str(cmd), "--chips", str(CHIPS),
             "--compare"]
     bad = subprocess.run(base + ["--bug", "1", "--model-bug", "0"], capture_output=True,
@@ -240,7 +243,7 @@ def test_fast_forward_hands_over_exactly(seed, tmp_path, bug):
     CSV, the frame and a line breakpoint are identical to a run that simulates every cycle
     in the traced model (--no-fast-forward). Many lines, so the hand-over is deep in the
     stream and spans cross the chip boundary."""
-    from diffengine import randgen
+    from diffengine.regress import randgen
 
     assert have_fst2vcd(), "fst2vcd (gtkwave) is needed: scripts/ensure_fst.sh"
     cmds = randgen.stream(seed, 500, N_PE, (1, 40))

@@ -21,7 +21,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diffengine import asm, cli, functional, isa, randgen, trace
+from diffengine.formats import asm
+from diffengine.cli import tree as cli
+from diffengine.model import functional
+from diffengine import isa
+from diffengine.regress import randgen
+from diffengine.rtl import trace
 
 REPO = Path(__file__).resolve().parents[2]
 CHIPS = 2

@@ -11,21 +11,24 @@ from pathlib import Path
 
 import numpy as np
 
-from diffengine import asm, functional, regress
+from diffengine.formats import asm
+from diffengine.model import functional
+from diffengine.cli import main as cli_main
+from diffengine.regress import cases as regress_cases, run as regress_run
 
 REPO = Path(__file__).resolve().parents[2]
 
 
 def test_smoke_tier(tmp_path):
-    if not regress.YPROC.exists():  # the scene case needs sw/hsr's y-processor (plain C)
+    if not regress_cases.YPROC.exists():  # the scene case needs sw/hsr's y-processor (plain C)
         subprocess.run(["make", "-s", "-C", str(REPO / "sw" / "hsr"), "build/yproc"],
                        check=True)
     out = tmp_path / "out"
-    rc = regress.main(["--tier", "smoke", "-j", "2", "--out", str(out)])
+    rc = cli_main(["sim", "--tier", "smoke", "-j", "2", "--out", str(out)])
     summary = (out / "summary.txt").read_text()
     print(summary)
     assert rc == 0, summary
-    cases = regress.load_manifest(regress.MANIFEST, "smoke")
+    cases = regress_cases.load_manifest(regress_cases.MANIFEST, "smoke")
     kinds = {c.kind for c in cases}
     assert {"file", "random", "carry", "chipcross", "scene"} <= kinds
     assert all(c.chips <= 2 for c in cases)
@@ -61,12 +64,12 @@ def test_corrupted_reference_fails(tmp_path):
     ref = want.copy()
     ref[bad_y, bad_x] ^= 0x10
     ref[3, 12] += 1                           # a later one: the report must name the first
-    regress.write_frame_text(tmp_path / "corrupt.txt", ref)
+    regress_run.write_frame_text(tmp_path / "corrupt.txt", ref)
     (tmp_path / "manifest.toml").write_text(
         f'[[file]]\npaths = ["{src.relative_to(REPO)}"]\nchips = [2]\ntier = "smoke"\n'
         'reference = "corrupt.txt"\n')
     out = tmp_path / "out"
-    rc = regress.main(["--manifest", str(tmp_path / "manifest.toml"), "--tier", "smoke",
+    rc = cli_main(["sim", "--manifest", str(tmp_path / "manifest.toml"), "--tier", "smoke",
                        "--out", str(out), "-j", "1", "--no-waves"])
     assert rc == 1, "a wrong reference must fail the regression"
     suite = ET.parse(out / "junit.xml").getroot()
@@ -77,7 +80,7 @@ def test_corrupted_reference_fails(tmp_path):
     assert "2 pixel(s) differ" in fail.get("message")
     # the commands of line 2 acting on column 7, with their stream index
     cmds = asm.parse_file(src)
-    touching = regress.touching(cmds, bad_y, bad_x)
+    touching = regress_run.touching(cmds, bad_y, bad_x)
     # by hand: line 2 = commands 7..11; Dis (8, 2) (7) misses column 7
     assert [k for k, _ in touching] == [8, 9, 10, 11]  # Eval2, Eval0, Eval2, Refresh
     for k, c in touching:

@@ -101,8 +101,9 @@ void dom_finish_extent(hsr_domain *d)
     hsr_extent x = {1, 1, 0, 0};
     for (int i = 0; i < d->n; i++) {
         const edge *e = &d->e[i];
-        int64_t l0 = x_floor(&e->ln, e->y0), l1 = x_floor(&e->ln, e->y1);
-        int64_t r0 = x_ceil(&e->ln, e->y0), r1 = x_ceil(&e->ln, e->y1);
+        int64_t l0, l1, r0, r1;
+        x_floor_ceil(&e->ln, e->y0, &l0, &r0);
+        x_floor_ceil(&e->ln, e->y1, &l1, &r1);
         int64_t l = l0 < l1 ? l0 : l1, r = r0 > r1 ? r0 : r1;
         int64_t b = ry_floor(e->y0), t = ry_ceil(e->y1);
         if (i == 0) { x.left = l; x.right = r; x.bot = b; x.top = t; continue; }

@@ -84,6 +84,22 @@ static inline int64_t ry_floor(ry y) { return (int64_t)floordiv128(y.p, y.q); }
 static inline int64_t ry_ceil(ry y) { return (int64_t)-floordiv128(-y.p, y.q); }
 static inline int64_t x_floor(const line *a, ry y) { return (int64_t)floordiv128(xnum(a, y), (i128)a->dy * y.q); }
 static inline int64_t x_ceil(const line *a, ry y) { return (int64_t)-floordiv128(-xnum(a, y), (i128)a->dy * y.q); }
+/* x_floor and x_ceil of the same point from one division: with the quotient
+ * q0 truncated toward zero and remainder r, floor = q0 - (r != 0 && n < 0) and
+ * ceil = q0 + (r != 0 && n > 0), the values the two calls give. */
+static inline void x_floor_ceil(const line *a, ry y, int64_t *fl, int64_t *ce)
+{
+    i128 n = xnum(a, y), d = (i128)a->dy * y.q;
+    if (n >= INT64_MIN && n <= INT64_MAX && d <= INT64_MAX) {
+        int64_t n6 = (int64_t)n, d6 = (int64_t)d, q0 = n6 / d6, r = n6 % d6;
+        *fl = q0 - (r != 0 && n6 < 0);
+        *ce = q0 + (r != 0 && n6 > 0);
+        return;
+    }
+    i128 q0 = n / d, r = n % d;
+    *fl = (int64_t)(q0 - (r != 0 && n < 0));
+    *ce = (int64_t)(q0 + (r != 0 && n > 0));
+}
 
 /* domain.c */
 hsr_domain *dom_new(void);

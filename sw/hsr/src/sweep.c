@@ -188,10 +188,11 @@ hsr_status sweep_overlay_pieces(const sweep_in *in, int nin, const int64_t *hcut
         for (int j = 0; j < in[i].n; j++) {
             const edge *e = &in[i].e[j];
             sedge s = {e, in[i].src, 0, 0};
-            int64_t a = x_floor(&e->ln, e->y0), b = x_floor(&e->ln, e->y1);
+            int64_t a, b, ca, cb;
+            x_floor_ceil(&e->ln, e->y0, &a, &ca);
+            x_floor_ceil(&e->ln, e->y1, &b, &cb);
             s.xmin = (a < b ? a : b) - 1;
-            a = x_ceil(&e->ln, e->y0); b = x_ceil(&e->ln, e->y1);
-            s.xmax = (a > b ? a : b) + 1;
+            s.xmax = (ca > cb ? ca : cb) + 1;
             PUSH(S.E, S.nE, S.capE, s);
             PUSH(S.Y, S.nY, S.capY, e->y0);
             PUSH(S.Y, S.nY, S.capY, e->y1);

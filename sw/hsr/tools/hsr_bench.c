@@ -1,4 +1,4 @@
-/* hsr_bench - benchmark entry points of sw/hsr (driven by scripts/bench_hsr.py).
+/* hsr_bench - benchmark entry points of sw/hsr (driven by diffengine bench hsr).
  *
  *   hsr_bench grid EXTENTS W SIZE NQ N1 [N2 ...]
  *       EXTENTS: text file, one "left bot right top" (integers) per line,
