@@ -108,12 +108,14 @@ module de_sdram_ctrl #(
     $error("de_sdram_ctrl: tREFI / tInit out of the counters' range");
   end
 
-  // "since" counters count clocks since a command and saturate at 255 ("long ago"). A
-  // command in the clock after another is 1 clock after it, so "a gap of at least N
-  // clocks" is since_q >= N - 1. For 125 MHz that test is registered: the flag f_*_q
-  // says it for this clock, computed in the clock before from the counter and from
-  // whether the command restarts it now (ge_next), so no comparator sits between the
-  // command decision and the pins.
+  // Gap checks, built for 125 MHz. A command decided now (cmd_d) is on the pins in the
+  // next clock; its restart strobe r_* is registered (r_*_q, the clock it is on the
+  // pins) and restarts its "since" counter there, so the decision drives only the pins
+  // and those strobes. A counter (saturating at 255, "long ago") restarted from r_*_q
+  // reads 0 two clocks after the decision, so "at least N clocks between two commands"
+  // is since >= N - 2; the flag f_*_q says it for this clock, computed a clock ahead
+  // (ge_next with N - 1), and is masked in the clock right after the command (e_*: the
+  // counter has not restarted yet), which costs one clock only for 1-clock timings.
   localparam int unsigned SW = 8;
   typedef logic [SW-1:0] since_t;
 
@@ -168,11 +170,20 @@ module de_sdram_ctrl #(
   since_t [NBanks-1:0] s_act_d, s_act_q, s_pre_d, s_pre_q, s_rd_d, s_rd_q, s_wr_d, s_wr_q;
   since_t s_act_any_d, s_act_any_q, s_read_d, s_read_q, s_ref_d, s_ref_q, s_mrs_d, s_mrs_q;
   // Restart strobes of the counters (this clock's command).
-  logic [NBanks-1:0] r_act, r_pre, r_rd, r_wr;
+  logic [NBanks-1:0] r_act, r_pre, r_rd, r_wr, r_act_q, r_pre_q, r_rd_q, r_wr_q;
   logic              r_act_any, r_read, r_ref, r_mrs, r_refcnt;
+  logic              r_act_any_q, r_read_q, r_ref_q, r_mrs_q;
+  // Flags as the decision uses them (f masked by a restart on the pins now).
+  logic [NBanks-1:0] e_rp, e_ras, e_wr, e_rdb;
+  logic              e_rrd, e_rfc, e_mrd, e_bl, e_rdwr;
+  // The request's bank's e_* flags, registered (the bank is fixed while it is served),
+  // so no bank multiplexer sits in front of the decision.
+  logic              c_rcd_d, c_rcd_q, c_rp_d, c_rp_q, c_rc_d, c_rc_q, c_ras_d, c_ras_q;
+  logic              c_wr_d, c_wr_q, c_rdb_d, c_rdb_q;
   // Registered gap flags: per bank tRCD, tRP, tRC, tRAS, tWR, own burst out; device tRRD,
   // tRFC, tMRD, READ-to-READ (8 beats), READ-to-WRITE (bus free).
-  logic [NBanks-1:0] f_rcd_d, f_rcd_q, f_rp_d, f_rp_q, f_rc_d, f_rc_q, f_ras_d, f_ras_q;
+  logic [NBanks-1:0] f_rp_d, f_rp_q, f_ras_d, f_ras_q;
+  logic [NBanks-1:0] f_rcd_d, f_rc_d;        // used through c_rcd / c_rc only
   logic [NBanks-1:0] f_wr_d, f_wr_q, f_rdb_d, f_rdb_q;
   logic              f_rrd_d, f_rrd_q, f_rfc_d, f_rfc_q, f_mrd_d, f_mrd_q;
   logic              f_bl_d, f_bl_q, f_rdwr_d, f_rdwr_q;
@@ -184,8 +195,9 @@ module de_sdram_ctrl #(
   logic [AW-1:0]       cur_addr_d, cur_addr_q;
   logic [31:0]         cur_data_d, cur_data_q;
   logic [TagW-1:0]     cur_tag_d, cur_tag_q;
-  logic                cur_open_d, cur_open_q;       // its bank has a row open
-  logic                cur_hit_d, cur_hit_q;         // ... and it is the request's row
+  // The request's next command, one-hot, set when it is accepted: PRECHARGE (another
+  // row is open), ACT (its bank is idle) or READ/WRITE (its row is open).
+  logic                st_pre_d, st_pre_q, st_act_d, st_act_q, st_rw_d, st_rw_q;
   logic [TagW-1:0]     iss_tag_d, iss_tag_q;         // tag of the READ on the pins
 
   // Pins.
@@ -211,27 +223,44 @@ module de_sdram_ctrl #(
   assign cur_row  = cur_addr_q[ColBits-1 +: RowBits];
   assign cur_colw = cur_addr_q[ColBits-2:0];
 
+  // The request that would be accepted now (reads first).
+  logic [BankBits-1:0] new_bank;
+  logic [RowBits-1:0]  new_row;
+  assign new_bank = rd_req_valid_i ? rd_req_addr_i[AW-1 -: BankBits] : wr_addr_i[AW-1 -: BankBits];
+  assign new_row  = rd_req_valid_i ? rd_req_addr_i[ColBits-1 +: RowBits] :
+                                     wr_addr_i[ColBits-1 +: RowBits];
+
   logic accept;
   assign accept         = (state_q == SRun) && !cur_valid_q && !ref_due_q;
   assign rd_req_ready_o = accept;
   assign wr_ready_o     = accept && !rd_req_valid_i;
 
   // ---------------------------------------------------------------- command decision
-  logic hit, miss_open, can_act, can_pre, can_read, can_write, all_pre_ok, all_closed_ok;
+  // Each command of the request is one AND of its step and its registered gap flags, so
+  // the five are exclusive and no priority chain sits in front of the pins.
+  logic do_pre, do_act, do_rd, do_wr, do_wr2, all_pre_ok, all_closed_ok;
 
   always_comb begin
-    hit       = cur_hit_q;
-    miss_open = cur_open_q && !cur_hit_q;
-    can_act   = f_rp_q[cur_bank] && f_rc_q[cur_bank] && f_rrd_q && f_rfc_q && f_mrd_q;
+    e_ras  = f_ras_q & ~r_act_q;
+    e_rp   = f_rp_q & ~r_pre_q;
+    e_wr   = f_wr_q & ~r_wr_q;
+    e_rdb  = f_rdb_q & ~r_rd_q;
+    e_rrd  = f_rrd_q & ~r_act_any_q;
+    e_bl   = f_bl_q & ~r_read_q;
+    e_rdwr = f_rdwr_q & ~r_read_q;
+    e_rfc  = f_rfc_q & ~r_ref_q;
+    e_mrd  = f_mrd_q & ~r_mrs_q;
     // A PRECHARGE ends the bank's read data CasLatency-1 clocks later: not before the
-    // 8 beats of its last READ are out (f_rdb).
-    can_pre   = f_ras_q[cur_bank] && f_wr_q[cur_bank] && f_rdb_q[cur_bank];
-    can_read  = hit && f_rcd_q[cur_bank] && f_bl_q;
+    // 8 beats of its last READ are out (rdb).
+    do_pre = st_pre_q && c_ras_q && c_wr_q && c_rdb_q;
+    do_act = st_act_q && c_rp_q && c_rc_q && e_rrd && e_rfc && e_mrd;
+    do_rd  = st_rw_q && !cur_write_q && c_rcd_q && e_bl;
     // The write data must not meet read data on DQ: the last READ's beats are on the
-    // bus until CasLatency + 7 clocks after it (f_rdwr).
-    can_write = hit && f_rcd_q[cur_bank] && f_rdwr_q;
-    all_pre_ok    = &(~open_q | (f_ras_q & f_wr_q & f_rdb_q));
-    all_closed_ok = &f_rp_q;
+    // bus until CasLatency + 7 clocks after it (rdwr).
+    do_wr  = st_rw_q && cur_write_q && c_rcd_q && e_rdwr;
+    do_wr2 = cur_beat_q;                       // the high half, the clock after do_wr
+    all_pre_ok    = &(~open_q | (e_ras & e_wr & e_rdb));
+    all_closed_ok = &e_rp;
   end
 
   always_comb begin
@@ -256,8 +285,9 @@ module de_sdram_ctrl #(
     cur_addr_d  = cur_addr_q;
     cur_data_d  = cur_data_q;
     cur_tag_d   = cur_tag_q;
-    cur_open_d  = cur_open_q;
-    cur_hit_d   = cur_hit_q;
+    st_pre_d    = st_pre_q;
+    st_act_d    = st_act_q;
+    st_rw_d     = st_rw_q;
     iss_tag_d   = iss_tag_q;
     cmd_d       = CmdNop;
     ba_d        = ba_q;
@@ -278,7 +308,7 @@ module de_sdram_ctrl #(
         state_d = SInitRef;
       end
       SInitRef: begin
-        if (all_closed_ok && f_rfc_q) begin
+        if (all_closed_ok && e_rfc) begin
           cmd_d      = CmdRef;
           r_ref      = 1'b1;
           init_ref_d = 1'b1;
@@ -286,7 +316,7 @@ module de_sdram_ctrl #(
         end
       end
       SInitLmr: begin
-        if (f_rfc_q) begin
+        if (e_rfc) begin
           cmd_d   = CmdLmr;
           ba_d    = '0;
           a_d     = ModeWord;
@@ -310,60 +340,70 @@ module de_sdram_ctrl #(
             cur_addr_d  = wr_addr_i;
             cur_data_d  = wr_data_i;
           end
-          // No command goes in this clock, so open_q / row_q are final: whether the new
-          // request's row is open is decided here, off the command path.
-          cur_open_d = open_q[cur_addr_d[AW-1 -: BankBits]];
-          cur_hit_d  = cur_open_d &&
-                       (row_q[cur_addr_d[AW-1 -: BankBits]] == cur_addr_d[ColBits-1 +: RowBits]);
-        end else if (cur_write_q && cur_beat_q) begin
-          // Second beat of a write: the high half, one column on, the next clock.
-          cmd_d    = CmdWrite;
-          ba_d     = cur_bank;
-          a_d      = PinAW'({cur_colw, 1'b1});
-          dq_d     = cur_data_q[31:16];
-          dq_oe_d  = 1'b1;
-          r_wr[cur_bank] = 1'b1;
+          // No command goes in this clock, so open_q / row_q are final: the new request's
+          // first command is decided here, from the port (new_*), off the command path.
+          if (cur_valid_d) begin
+            st_rw_d  = open_q[new_bank] && (row_q[new_bank] == new_row);
+            st_act_d = !open_q[new_bank];
+            st_pre_d = !st_rw_d && !st_act_d;
+          end
+        end
+        // Address and data follow the request's step alone (the pins carry a NOP when
+        // no command goes), so only cmd_d and the restarts wait for the gap flags.
+        if (cur_valid_q) begin
+          ba_d = cur_bank;
+          dq_d = cur_beat_q ? cur_data_q[31:16] : cur_data_q[15:0];
+          if (st_act_q) begin
+            a_d = cur_row;
+          end else if (st_pre_q) begin
+            a_d = '0;                                      // A10 = 0: this bank only
+          end else begin
+            a_d = PinAW'({cur_colw, cur_beat_q});
+          end
+        end
+        dq_oe_d = do_wr || do_wr2;
+        if (do_wr2) begin
+          // Second beat of a write: the high half, one column on.
+          cmd_d       = CmdWrite;
           cur_valid_d = 1'b0;
           cur_beat_d  = 1'b0;
-        end else if (miss_open) begin
-          if (can_pre) begin
-            cmd_d = CmdPre;
-            ba_d  = cur_bank;
-            a_d   = '0;                                    // A10 = 0: this bank only
-            open_d[cur_bank] = 1'b0;
-            r_pre[cur_bank]  = 1'b1;
-            cur_open_d       = 1'b0;
-          end
-        end else if (!hit) begin
-          if (can_act) begin
-            cmd_d = CmdAct;
-            ba_d  = cur_bank;
-            a_d   = cur_row;
-            open_d[cur_bank] = 1'b1;
-            row_d[cur_bank]  = cur_row;
-            r_act[cur_bank]  = 1'b1;
-            r_act_any        = 1'b1;
-            cur_open_d       = 1'b1;
-            cur_hit_d        = 1'b1;
-          end
-        end else if (cur_write_q) begin
-          if (can_write) begin
-            cmd_d   = CmdWrite;
-            ba_d    = cur_bank;
-            a_d     = PinAW'({cur_colw, 1'b0});
-            dq_d    = cur_data_q[15:0];
-            dq_oe_d = 1'b1;
-            r_wr[cur_bank] = 1'b1;
-            cur_beat_d = 1'b1;
-          end
-        end else if (can_read) begin
-          cmd_d = CmdRead;
-          ba_d  = cur_bank;
-          a_d   = PinAW'({cur_colw, 1'b0});
-          r_rd[cur_bank] = 1'b1;
-          r_read      = 1'b1;
+        end
+        if (do_pre) begin
+          cmd_d    = CmdPre;
+          st_pre_d = 1'b0;
+          st_act_d = 1'b1;
+        end
+        if (do_act) begin
+          cmd_d    = CmdAct;
+          st_act_d = 1'b0;
+          st_rw_d  = 1'b1;
+        end
+        if (do_wr) begin
+          cmd_d      = CmdWrite;
+          st_rw_d    = 1'b0;
+          cur_beat_d = 1'b1;
+        end
+        if (do_rd) begin
+          cmd_d       = CmdRead;
           iss_tag_d   = cur_tag_q;
+          st_rw_d     = 1'b0;
           cur_valid_d = 1'b0;
+        end
+        // Bank state and counter restarts follow the command.
+        if (do_pre) begin
+          open_d[cur_bank] = 1'b0;
+          r_pre[cur_bank]  = 1'b1;
+        end
+        if (do_act) begin
+          open_d[cur_bank] = 1'b1;
+          row_d[cur_bank]  = cur_row;
+          r_act[cur_bank]  = 1'b1;
+          r_act_any        = 1'b1;
+        end
+        if (do_wr || do_wr2) r_wr[cur_bank] = 1'b1;
+        if (do_rd) begin
+          r_rd[cur_bank] = 1'b1;
+          r_read         = 1'b1;
         end
       end
       SRefPre: begin
@@ -379,7 +419,7 @@ module de_sdram_ctrl #(
         end
       end
       SRef: begin
-        if (all_closed_ok && f_rfc_q) begin
+        if (all_closed_ok && e_rfc) begin
           cmd_d     = CmdRef;
           r_ref     = 1'b1;
           r_refcnt  = 1'b1;
@@ -395,27 +435,35 @@ module de_sdram_ctrl #(
   always_comb begin
     ref_cnt_d   = r_refcnt ? '0 : ((ref_cnt_q == '1) ? ref_cnt_q : ref_cnt_q + 1'b1);
     ref_due_d   = !r_refcnt && (ref_cnt_q >= 16'(NRefi - 1));
-    s_act_any_d = r_act_any ? '0 : inc(s_act_any_q);
-    s_read_d    = r_read ? '0 : inc(s_read_q);
-    s_ref_d     = r_ref ? '0 : inc(s_ref_q);
-    s_mrs_d     = r_mrs ? '0 : inc(s_mrs_q);
-    f_rrd_d     = ge_next(s_act_any_q, r_act_any, NRrd);
-    f_bl_d      = ge_next(s_read_q, r_read, NBl);
-    f_rdwr_d    = ge_next(s_read_q, r_read, CasLatency + NBl);
-    f_rfc_d     = ge_next(s_ref_q, r_ref, NRfc);
-    f_mrd_d     = ge_next(s_mrs_q, r_mrs, NMrd);
+    s_act_any_d = r_act_any_q ? '0 : inc(s_act_any_q);
+    s_read_d    = r_read_q ? '0 : inc(s_read_q);
+    s_ref_d     = r_ref_q ? '0 : inc(s_ref_q);
+    s_mrs_d     = r_mrs_q ? '0 : inc(s_mrs_q);
+    f_rrd_d     = ge_next(s_act_any_q, r_act_any_q, NRrd - 1);
+    f_bl_d      = ge_next(s_read_q, r_read_q, NBl - 1);
+    f_rdwr_d    = ge_next(s_read_q, r_read_q, CasLatency + NBl - 1);
+    f_rfc_d     = ge_next(s_ref_q, r_ref_q, NRfc - 1);
+    f_mrd_d     = ge_next(s_mrs_q, r_mrs_q, NMrd - 1);
     for (int unsigned b = 0; b < NBanks; b++) begin
-      s_act_d[b] = r_act[b] ? '0 : inc(s_act_q[b]);
-      s_pre_d[b] = r_pre[b] ? '0 : inc(s_pre_q[b]);
-      s_rd_d[b]  = r_rd[b] ? '0 : inc(s_rd_q[b]);
-      s_wr_d[b]  = r_wr[b] ? '0 : inc(s_wr_q[b]);
-      f_rcd_d[b] = ge_next(s_act_q[b], r_act[b], NRcd);
-      f_rc_d[b]  = ge_next(s_act_q[b], r_act[b], NRc);
-      f_ras_d[b] = ge_next(s_act_q[b], r_act[b], NRas);
-      f_rp_d[b]  = ge_next(s_pre_q[b], r_pre[b], NRp);
-      f_wr_d[b]  = ge_next(s_wr_q[b], r_wr[b], NWr);
-      f_rdb_d[b] = ge_next(s_rd_q[b], r_rd[b], NBl);
+      s_act_d[b] = r_act_q[b] ? '0 : inc(s_act_q[b]);
+      s_pre_d[b] = r_pre_q[b] ? '0 : inc(s_pre_q[b]);
+      s_rd_d[b]  = r_rd_q[b] ? '0 : inc(s_rd_q[b]);
+      s_wr_d[b]  = r_wr_q[b] ? '0 : inc(s_wr_q[b]);
+      f_rcd_d[b] = ge_next(s_act_q[b], r_act_q[b], NRcd - 1);
+      f_rc_d[b]  = ge_next(s_act_q[b], r_act_q[b], NRc - 1);
+      f_ras_d[b] = ge_next(s_act_q[b], r_act_q[b], NRas - 1);
+      f_rp_d[b]  = ge_next(s_pre_q[b], r_pre_q[b], NRp - 1);
+      f_wr_d[b]  = ge_next(s_wr_q[b], r_wr_q[b], NWr - 1);
+      f_rdb_d[b] = ge_next(s_rd_q[b], r_rd_q[b], NBl - 1);
     end
+    // Next clock's e_* of the next clock's request bank: f_*_d masked by this clock's
+    // restart strobes (next clock's r_*_q).
+    c_rcd_d = f_rcd_d[cur_addr_d[AW-1 -: BankBits]] && !r_act[cur_addr_d[AW-1 -: BankBits]];
+    c_rc_d  = f_rc_d[cur_addr_d[AW-1 -: BankBits]] && !r_act[cur_addr_d[AW-1 -: BankBits]];
+    c_ras_d = f_ras_d[cur_addr_d[AW-1 -: BankBits]] && !r_act[cur_addr_d[AW-1 -: BankBits]];
+    c_rp_d  = f_rp_d[cur_addr_d[AW-1 -: BankBits]] && !r_pre[cur_addr_d[AW-1 -: BankBits]];
+    c_wr_d  = f_wr_d[cur_addr_d[AW-1 -: BankBits]] && !r_wr[cur_addr_d[AW-1 -: BankBits]];
+    c_rdb_d = f_rdb_d[cur_addr_d[AW-1 -: BankBits]] && !r_rd[cur_addr_d[AW-1 -: BankBits]];
   end
 
   // ---------------------------------------------------------------- read data
@@ -468,9 +516,7 @@ module de_sdram_ctrl #(
       s_read_q    <= '1;
       s_ref_q     <= '1;
       s_mrs_q     <= '1;
-      f_rcd_q     <= '1;
       f_rp_q      <= '1;
-      f_rc_q      <= '1;
       f_ras_q     <= '1;
       f_wr_q      <= '1;
       f_rdb_q     <= '1;
@@ -479,14 +525,29 @@ module de_sdram_ctrl #(
       f_mrd_q     <= 1'b1;
       f_bl_q      <= 1'b1;
       f_rdwr_q    <= 1'b1;
+      r_act_q     <= '0;
+      r_pre_q     <= '0;
+      r_rd_q      <= '0;
+      r_wr_q      <= '0;
+      r_act_any_q <= 1'b0;
+      r_read_q    <= 1'b0;
+      r_ref_q     <= 1'b0;
+      r_mrs_q     <= 1'b0;
+      c_rcd_q     <= 1'b1;
+      c_rc_q      <= 1'b1;
+      c_ras_q     <= 1'b1;
+      c_rp_q      <= 1'b1;
+      c_wr_q      <= 1'b1;
+      c_rdb_q     <= 1'b1;
       cur_valid_q <= 1'b0;
       cur_write_q <= 1'b0;
       cur_beat_q  <= 1'b0;
       cur_addr_q  <= '0;
       cur_data_q  <= '0;
       cur_tag_q   <= '0;
-      cur_open_q  <= 1'b0;
-      cur_hit_q   <= 1'b0;
+      st_pre_q    <= 1'b0;
+      st_act_q    <= 1'b0;
+      st_rw_q     <= 1'b0;
       iss_tag_q   <= '0;
       cmd_q       <= CmdNop;
       ba_q        <= '0;
@@ -516,9 +577,7 @@ module de_sdram_ctrl #(
       s_read_q    <= s_read_d;
       s_ref_q     <= s_ref_d;
       s_mrs_q     <= s_mrs_d;
-      f_rcd_q     <= f_rcd_d;
       f_rp_q      <= f_rp_d;
-      f_rc_q      <= f_rc_d;
       f_ras_q     <= f_ras_d;
       f_wr_q      <= f_wr_d;
       f_rdb_q     <= f_rdb_d;
@@ -527,14 +586,29 @@ module de_sdram_ctrl #(
       f_mrd_q     <= f_mrd_d;
       f_bl_q      <= f_bl_d;
       f_rdwr_q    <= f_rdwr_d;
+      r_act_q     <= r_act;
+      r_pre_q     <= r_pre;
+      r_rd_q      <= r_rd;
+      r_wr_q      <= r_wr;
+      r_act_any_q <= r_act_any;
+      r_read_q    <= r_read;
+      r_ref_q     <= r_ref;
+      r_mrs_q     <= r_mrs;
+      c_rcd_q     <= c_rcd_d;
+      c_rc_q      <= c_rc_d;
+      c_ras_q     <= c_ras_d;
+      c_rp_q      <= c_rp_d;
+      c_wr_q      <= c_wr_d;
+      c_rdb_q     <= c_rdb_d;
       cur_valid_q <= cur_valid_d;
       cur_write_q <= cur_write_d;
       cur_beat_q  <= cur_beat_d;
       cur_addr_q  <= cur_addr_d;
       cur_data_q  <= cur_data_d;
       cur_tag_q   <= cur_tag_d;
-      cur_open_q  <= cur_open_d;
-      cur_hit_q   <= cur_hit_d;
+      st_pre_q    <= st_pre_d;
+      st_act_q    <= st_act_d;
+      st_rw_q     <= st_rw_d;
       iss_tag_q   <= iss_tag_d;
       cmd_q       <= cmd_d;
       ba_q        <= ba_d;

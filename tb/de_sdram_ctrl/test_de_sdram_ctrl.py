@@ -12,7 +12,8 @@ Structure:
   Checker  - every read word equals the model's, in order, with the request's tag; the
              SDRAM model's error counter stays 0; refreshes counted.
 
-Tests (build: 125 MHz, CL 3, power-up wait shortened to 2 us):
+Builds: 125 MHz with CL 3 (the board's), 100 MHz with CL 2; power-up wait shortened
+to 2 us. Tests:
   random_rw   - random writes and 4-word reads over a few rows of every bank (hits,
                 misses, bank conflicts), reads verified against the dict;
   stream      - three "colours", each streaming its own bank sequentially (rows change
@@ -29,7 +30,6 @@ from collections import deque
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent.parent
 sys.path.insert(0, str(HERE.parent))
 
 try:
@@ -39,8 +39,9 @@ try:
 except ImportError:  # pragma: no cover
     cocotb = None
 
-TCK_PS = 8000
-CL = 3
+# The build's clock and CAS latency (pytest passes them; see BUILDS).
+TCK_PS = int(os.environ.get("SDRAM_TCK", "8000"))
+CL = int(os.environ.get("SDRAM_CL", "3"))
 AW = 23
 REFI = 7_812_500 // TCK_PS          # clocks per tREFI
 
@@ -219,8 +220,18 @@ async def stream(dut):
 
 # ---- pytest runner --------------------------------------------------------------------------
 
-def test_de_sdram_ctrl():
-    from common.run import build_and_test, rtl_files
-    srcs = rtl_files("diffengine:tb:de_sdram_ctrl")   # tb/de_sdram_ctrl/de_sdram_ctrl_tb.core
-    build_and_test(HERE, "tb_sdram_ctrl", srcs, "test_de_sdram_ctrl",
-                   parameters={"TckPs": TCK_PS, "CasLatency": CL})
+BUILDS = {"125mhz_cl3": (8000, 3), "100mhz_cl2": (10000, 2)}
+
+try:
+    import pytest
+
+    @pytest.mark.parametrize("build", list(BUILDS))
+    def test_de_sdram_ctrl(build):
+        from common.run import build_and_test, rtl_files
+        tck, cl = BUILDS[build]
+        srcs = rtl_files("diffengine:tb:de_sdram_ctrl")   # tb/de_sdram_ctrl/de_sdram_ctrl_tb.core
+        build_and_test(HERE, "tb_sdram_ctrl", srcs, "test_de_sdram_ctrl",
+                       parameters={"TckPs": tck, "CasLatency": cl},
+                       extra_env={"SDRAM_TCK": str(tck), "SDRAM_CL": str(cl)})
+except ImportError:  # pragma: no cover
+    pass
