@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "Vdisplay_controller.h"
+#include "de_isa.h"
 #include "verilated.h"
 #include <ctime>
 #include <unistd.h>
@@ -48,7 +49,7 @@
 namespace {
 
 constexpr int kCh = 3;
-constexpr uint16_t kRefresh = 0x100;
+constexpr uint16_t kRefresh = DE_ID_REFRESH;
 
 struct Geom {
   int ha, hfp, hs, hbp, va, vfp, vs, vbp;
@@ -57,17 +58,16 @@ struct Geom {
   int vtotal() const { return va + vfp + vs + vbp; }
 };
 
-// docs/display-controller.md §3.
+// docs/display-controller.md §3; the fixed modes come from de_isa.h (spec/video.toml).
 Geom mode_geom(int mode) {
-  switch (mode) {
-    case 1: return {640, 8, 24, 11, 485, 11, 2, 27, false, false};
-    case 2: return {1280, 48, 112, 248, 1024, 1, 3, 38, true, true};
-    case 3: {
-      const int t[8] = {DC_TEST_GEOM};  // the Test* parameters of this build
-      return {t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], false, false};
-    }
-    default: return {640, 16, 96, 48, 480, 10, 2, 33, false, false};
+  if (mode == DE_VIDEO_MODE_TEST) {
+    const int t[8] = {DC_TEST_GEOM};  // the Test* parameters of this build
+    return {t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], false, false};
   }
+  const de_video_mode* m = de_video_mode_get(mode);
+  if (!m) m = de_video_mode_get(0);
+  return {m->h[0], m->h[1], m->h[2], m->h[3], m->v[0], m->v[1], m->v[2], m->v[3],
+          m->hpol != 0, m->vpol != 0};
 }
 
 bool read_de48(const char* path, std::vector<uint64_t>& out, std::string& err) {

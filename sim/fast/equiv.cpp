@@ -15,13 +15,8 @@
 
 #include "Vflat.h"
 #include "de_fast.h"
+#include "de_isa.h"
 #include "verilated.h"
-
-namespace {
-// The identifiers of the instruction look-up table (docs/isa.md), plus raw random ones.
-const uint16_t kOps[] = {0x000, 0x100, 0x001, 0x002, 0x800, 0x801, 0x802, 0x803, 0x200, 0x444,
-                         0x484, 0x4c4, 0x4b4, 0x464, 0x460, 0x450, 0x448, 0x488, 0x4c8};
-}  // namespace
 
 int main(int argc, char** argv) {
   long long cycles = 200000;
@@ -63,9 +58,11 @@ int main(int argc, char** argv) {
     de_fast::In in;
     in.rst = c < 3 || (c % 50000 == 25000 && pct(50));
     if (pct(90)) {
-      in.ident = pct(refresh_pct) ? 0x100 : kOps[rng() % (sizeof kOps / sizeof kOps[0])];
+      // The identifiers of the instruction look-up table, plus raw random ones below.
+      in.ident = static_cast<uint16_t>(pct(refresh_pct) ? DE_ID_REFRESH
+                                                        : de_lut_ident(rng() % DE_LUT_ENTRIES));
     } else {
-      in.ident = static_cast<uint16_t>(rng() & 0xfff);
+      in.ident = static_cast<uint16_t>(rng() & DE_ID_MASK);
     }
     const int kind = static_cast<int>(rng() % 4);
     in.data = kind == 0 ? (rng() & 0xfffffffffULL)

@@ -26,6 +26,8 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include "de_isa.h"
 #include <vector>
 
 #include "Vde_array.h"
@@ -44,29 +46,13 @@
 namespace {
 
 constexpr int kExitBreak = 3;   // a breakpoint stopped the run
-constexpr uint16_t kRefresh = 0x100;
+constexpr uint16_t kRefresh = DE_ID_REFRESH;
 constexpr int kPixLatency = 3;  // docs/array.md: exit(q) = R + NumChips + 3 + q
 constexpr int kPePerChip = 9;
 
 struct Instr {
   uint16_t ident;
   uint64_t data;
-};
-
-// The 19 identifiers of the instruction look-up table, as sw/diffengine/isa.py LUT
-// names them (--list-ops prints this table; a test compares it with isa.LUT).
-struct OpName {
-  const char* name;
-  uint16_t ident;
-};
-const OpName kOps[] = {
-    {"NOP", 0x000},        {"REFRESH", 0x100},       {"ACCMODE_ON", 0x001},
-    {"ACCMODE_OFF", 0x002}, {"ADDR_RANGE", 0x800},    {"ADDR_PERIODIC", 0x801},
-    {"ADDR_EVAL0", 0x802}, {"ADDR_DIS", 0x803},      {"ACC", 0x200},
-    {"D_A", 0x444},        {"D_B", 0x484},           {"D_C", 0x4c4},
-    {"D_B_C", 0x4b4},      {"D_A_B", 0x464},         {"D_A_B_NP", 0x460},
-    {"D_A_A_NP", 0x450},   {"SET_A", 0x448},         {"SET_B", 0x488},
-    {"SET_C", 0x4c8},
 };
 
 bool read_de48(const std::string& path, std::vector<Instr>& out, std::string& err) {
@@ -81,12 +67,12 @@ bool read_de48(const std::string& path, std::vector<Instr>& out, std::string& er
     std::fclose(f);
     return false;
   }
-  unsigned char w[6];
+  unsigned char w[DE_RECORD_BITS / 8];
   size_t n;
-  while ((n = std::fread(w, 1, 6, f)) == 6) {
+  while ((n = std::fread(w, 1, sizeof w, f)) == sizeof w) {
     uint64_t v = 0;
-    for (int i = 0; i < 6; ++i) v = (v << 8) | w[i];
-    out.push_back({static_cast<uint16_t>(v >> 36), v & ((1ULL << 36) - 1)});
+    for (unsigned char b : w) v = (v << 8) | b;
+    out.push_back({static_cast<uint16_t>(v >> DE_WORD_BITS), v & DE_WORD_MASK});
   }
   std::fclose(f);
   if (n != 0) {
@@ -198,13 +184,14 @@ bool parse_pe_list(const std::string& spec, int n_pe, std::vector<int>& out,
 }
 
 bool parse_op(const char* s, int& ident) {
-  for (const OpName& o : kOps)
-    if (!strcasecmp(s, o.name)) {
-      ident = o.ident;
+  // The identifiers by their look-up table names (de_isa.h, from spec/isa.toml).
+  for (unsigned c = 0; c < DE_LUT_ENTRIES; ++c)
+    if (!strcasecmp(s, de_lut_name(c))) {
+      ident = static_cast<int>(de_lut_ident(c));
       return true;
     }
   long long v;
-  if (parse_num(s, v) && v >= 0 && v < 4096) {
+  if (parse_num(s, v) && v >= 0 && v <= DE_ID_MASK) {
     ident = static_cast<int>(v);
     return true;
   }
@@ -328,7 +315,8 @@ std::string state_row(uint64_t cycle, const PeProbe& pr, const Instr& in0, long 
   uint64_t id, data;
   if (pr.pe == 0) {
     id = in0.ident;
-    data = (in0.data & 0xFFF) | (pr.skew1.get() << 12) | (pr.skew2.get() << 24);
+    data = (in0.data & DE_BLOCK_MASK) | (pr.skew1.get() << DE_BLOCK_BITS) |
+           (pr.skew2.get() << (2 * DE_BLOCK_BITS));
   } else {
     id = pr.in_id.get();
     data = pr.in_data.get();
@@ -563,7 +551,8 @@ int main(int argc, char** argv) {
     }
   }
   if (o.list_ops) {
-    for (const OpName& op : kOps) std::printf("%s 0x%03x\n", op.name, op.ident);
+    for (unsigned c = 0; c < DE_LUT_ENTRIES; ++c)
+      std::printf("%s 0x%03x\n", de_lut_name(c), de_lut_ident(c));
     return 0;
   }
   if (o.repeat < 1) o.repeat = 1;

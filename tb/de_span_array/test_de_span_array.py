@@ -193,11 +193,11 @@ async def slot_soup(dut):
     slots = []
     for _ in range(int(os.environ.get("N_SLOTS", 1500))):
         ident = rng.choices(ids, weights)[0]
-        if ident & 0x800:
+        if ident & isa.ID_ADDR:
             x = rng.choice([0, rng.randrange(n), n - 1, n + rng.randrange(3)])
             dx = rng.choice([0, 1, rng.randrange(1, n + 4), rng.randrange(4096)])
             data = x | dx << 12 | rng.randrange(4096) << 24
-        elif ident & 0x400:
+        elif ident & isa.ID_DATA:
             data = rng.randrange(1 << 36) if rng.random() < 0.3 else \
                 isa.to_word(rng.randrange(-8 * ONE, 8 * ONE))
         else:

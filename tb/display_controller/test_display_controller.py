@@ -44,7 +44,7 @@ sys.path.insert(0, str(HERE.parent.parent / "sw"))
 from diffengine import functional, isa, randgen  # noqa: E402
 
 NCH = 3
-REFRESH_ID = 0x100
+REFRESH_ID = isa.REFRESH
 MASK48 = (1 << 48) - 1
 
 

@@ -156,7 +156,7 @@ def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
     res = run(exe, src, tmp_path / "o", "--break-pe", 10, "--break-op", "acc", rc=3)
     c, rows = stopped(res)
     assert c == k + 10 + 1
-    assert "PE 10 (column 10) receives identifier 0x200" in res.stdout
+    assert f"PE 10 (column 10) receives identifier {isa.ACC:#05x}" in res.stdout
     assert [r.split(",")[1] for r in rows] == ["9", "10", "11"]
     assert rows[1].split(",")[2] == "200"
     # The same breakpoint from the model engine prints the same.
@@ -164,7 +164,7 @@ def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
                           break_op=isa.ACC)
     assert m.stop.splitlines() == res.stdout.splitlines()[:5]
     # Numeric identifiers work too, and the op table is isa.LUT.
-    assert stopped(run(exe, src, tmp_path / "o", "--break-pe", 10, "--break-op", "0x200",
+    assert stopped(run(exe, src, tmp_path / "o", "--break-pe", 10, "--break-op", f"{isa.ACC:#05x}",
                        rc=3))[0] == c
     listed = run(exe, src, tmp_path / "o", "--list-ops").stdout.split()
     assert dict(zip(listed[::2], (int(v, 16) for v in listed[1::2]))) == {
