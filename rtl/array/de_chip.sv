@@ -12,6 +12,8 @@
 // output is masked; relative addressing makes the remaining PEs a smaller array.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
 // (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
+`default_nettype none
+
 module de_chip
   import de_pkg::*;
 #(
@@ -251,3 +253,5 @@ module de_chip_bound
   assign pix_o       = pix_q;
   assign coll_o      = coll_q;
 endmodule
+
+`default_nettype wire

@@ -15,6 +15,8 @@
 //   up to and including the marker. Discarded words are reported on drop_o.
 // * hsync/vsync/de are delayed by 1 + ArrayLatency so that they line up with column 0
 //   of a line leaving the array ArrayLatency cycles after its Refresh is on instr_o.
+`default_nettype none
+
 module de_access_ctrl #(
   parameter int unsigned NumBuf       = 4,
   parameter int unsigned ArrayLatency = 3,
@@ -64,14 +66,14 @@ module de_access_ctrl #(
   localparam int unsigned PipeLen   = ArrayLatency + 1;
 
   // Parameter checks at elaboration.
-  if (NumBuf < 1 || NumBuf > 8) begin : gen_err_numbuf
-    $error("de_access_ctrl: NumBuf must be 1..8");
+  if (NumBuf < 1 || NumBuf > 8) begin : g_bad_numbuf
+    $fatal(1, "de_access_ctrl: NumBuf must be 1..8");
   end
-  if (ArrayLatency > 4095) begin : gen_err_latency
-    $error("de_access_ctrl: ArrayLatency must be < 4096");
+  if (ArrayLatency > 4095) begin : g_bad_latency
+    $fatal(1, "de_access_ctrl: ArrayLatency must be < 4096");
   end
-  if (SkipW < 2 || SkipW > 16) begin : gen_err_skipw
-    $error("de_access_ctrl: SkipW must be 2..16");
+  if (SkipW < 2 || SkipW > 16) begin : g_bad_skipw
+    $fatal(1, "de_access_ctrl: SkipW must be 2..16");
   end
 
   // ---------------------------------------------------------------------------------
@@ -96,7 +98,7 @@ module de_access_ctrl #(
   logic [NumBuf-1:0] done_d, done_q;
   logic [NumBuf-1:0][SkipW-1:0] skip_d, skip_q;
 
-  for (genvar i = 0; i < NumBuf; i++) begin : gen_head
+  for (genvar i = 0; i < NumBuf; i++) begin : g_head
     assign head_start[i]  = (buf_data_i[i][46:45] == 2'b00);
     assign head_marker[i] = (buf_data_i[i][47:36] == IdRefresh);
     assign skipping[i]    = (skip_q[i] != '0);
@@ -186,7 +188,7 @@ module de_access_ctrl #(
     end
   end
 
-  for (genvar i = 0; i < NumBuf; i++) begin : gen_ready
+  for (genvar i = 0; i < NumBuf; i++) begin : g_ready
     assign buf_ready_o[i] = grant[i] | mk_pop[i] | skipping[i];
     assign buf_drain_o[i] = skipping[i];
   end
@@ -334,3 +336,5 @@ module de_access_ctrl #(
 `endif
 
 endmodule
+
+`default_nettype wire

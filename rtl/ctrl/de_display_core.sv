@@ -12,6 +12,8 @@
 // * Output stage: one register for the 12-bit pixels (forced to zero while blanking), the
 //   8-bit window (pixel bits [w+7:w], optionally saturated) and hsync/vsync/blank, so
 //   everything leaves together.
+`default_nettype none
+
 module de_display_core #(
   parameter int unsigned NumBuf       = 4,    // y-processors (buffers per colour)
   parameter int unsigned BufDepth     = 16,   // words per instruction buffer
@@ -62,11 +64,11 @@ module de_display_core #(
 );
 
   // Parameter checks at elaboration (the sub-blocks check their own ranges too).
-  if (NumBuf < 1 || NumBuf > 8) begin : gen_err_numbuf
-    $error("de_display_core: NumBuf must be 1..8");
+  if (NumBuf < 1 || NumBuf > 8) begin : g_bad_numbuf
+    $fatal(1, "de_display_core: NumBuf must be 1..8");
   end
-  if (ArrayLatency < 1 || ArrayLatency > 4095) begin : gen_err_latency
-    $error("de_display_core: ArrayLatency must be 1..4095");
+  if (ArrayLatency < 1 || ArrayLatency > 4095) begin : g_bad_latency
+    $fatal(1, "de_display_core: ArrayLatency must be 1..4095");
   end
 
   // ---------------------------------------------------------------------------------
@@ -273,3 +275,5 @@ module de_display_core #(
   assign align_err_o = align_err_q;
 
 endmodule
+
+`default_nettype wire

@@ -18,6 +18,8 @@
 // so Depth > MaxCmdLen guarantees that a full buffer always has a committed head.
 // drain_i (used by the Access Controller to discard a late line) also offers the
 // uncommitted tail, so even a malformed stream cannot wedge the buffer.
+`default_nettype none
+
 module de_instr_buffer #(
   parameter int unsigned Depth     = 16,
   parameter int unsigned MaxCmdLen = 10
@@ -43,14 +45,14 @@ module de_instr_buffer #(
   localparam int unsigned AW = $clog2(Depth);
 
   // Parameter checks at elaboration.
-  if (Depth < 2) begin : gen_err_depth_small
-    $error("de_instr_buffer: Depth must be >= 2");
+  if (Depth < 2) begin : g_bad_depth_small
+    $fatal(1, "de_instr_buffer: Depth must be >= 2");
   end
-  if ((1 << AW) != Depth) begin : gen_err_depth_pow2
-    $error("de_instr_buffer: Depth must be a power of two");
+  if ((1 << AW) != Depth) begin : g_bad_depth_pow2
+    $fatal(1, "de_instr_buffer: Depth must be a power of two");
   end
-  if (Depth <= MaxCmdLen) begin : gen_err_depth_cmd
-    $error("de_instr_buffer: Depth must exceed MaxCmdLen (a whole command plus one)");
+  if (Depth <= MaxCmdLen) begin : g_bad_depth_cmd
+    $fatal(1, "de_instr_buffer: Depth must exceed MaxCmdLen (a whole command plus one)");
   end
 
   // Pointers carry one extra wrap bit so that full and empty are distinguishable.
@@ -199,3 +201,5 @@ module de_instr_buffer #(
 `endif
 
 endmodule
+
+`default_nettype wire

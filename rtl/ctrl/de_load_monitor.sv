@@ -10,6 +10,8 @@
 // * cumulative discard and late-line counters.
 // The host reads 32-bit registers through a synchronous read port (data one clock after
 // the address).
+`default_nettype none
+
 module de_load_monitor #(
   parameter int unsigned NumBuf   = 4,
   parameter int unsigned NumBins  = 16,
@@ -35,17 +37,17 @@ module de_load_monitor #(
   localparam int unsigned LineAw = (MaxLines > 1) ? $clog2(MaxLines) : 1;
 
   // Parameter checks at elaboration.
-  if (NumBuf < 1 || NumBuf > 8) begin : gen_err_numbuf
-    $error("de_load_monitor: NumBuf must be 1..8");
+  if (NumBuf < 1 || NumBuf > 8) begin : g_bad_numbuf
+    $fatal(1, "de_load_monitor: NumBuf must be 1..8");
   end
-  if (NumBins < 1 || NumBins > 64) begin : gen_err_bins
-    $error("de_load_monitor: NumBins must be 1..64");
+  if (NumBins < 1 || NumBins > 64) begin : g_bad_bins
+    $fatal(1, "de_load_monitor: NumBins must be 1..64");
   end
-  if (BinShift > 11) begin : gen_err_shift
-    $error("de_load_monitor: BinShift must be 0..11");
+  if (BinShift > 11) begin : g_bad_shift
+    $fatal(1, "de_load_monitor: BinShift must be 0..11");
   end
-  if (MaxLines < 1 || MaxLines > 1024) begin : gen_err_lines
-    $error("de_load_monitor: MaxLines must be 1..1024 (register window 0x400-0x7FF)");
+  if (MaxLines < 1 || MaxLines > 1024) begin : g_bad_lines
+    $fatal(1, "de_load_monitor: MaxLines must be 1..1024 (register window 0x400-0x7FF)");
   end
 
   // Number of set bits of a buffer vector (at most 8).
@@ -244,3 +246,5 @@ module de_load_monitor #(
   assign reg_rdata_o = sel_line_q ? line_rd_q : rdata_q;
 
 endmodule
+
+`default_nettype wire

@@ -9,6 +9,8 @@
 //
 // Line layout (both axes): [0, Active) active, then front porch, sync, back porch.
 // mode_i is sampled while rst_i is high and held until the next reset.
+`default_nettype none
+
 module de_video_timing #(
   // Mode 3 ("test mode"): small totals for fast simulation and formal checks.
   parameter int unsigned TestHActive = 16,
@@ -46,12 +48,12 @@ module de_video_timing #(
 
   // Parameter checks at elaboration.
   if (TestHActive < 1 || TestHSync < 1 || TestVActive < 1 || TestVSync < 1)
-  begin : gen_err_test_zero
-    $error("de_video_timing: test mode needs non-zero active and sync widths");
+  begin : g_bad_test_zero
+    $fatal(1, "de_video_timing: test mode needs non-zero active and sync widths");
   end
   if (TestHTotal < 4 || TestHTotal > 4095 || TestVTotal < 2 || TestVTotal > 4095)
-  begin : gen_err_test_total
-    $error("de_video_timing: test mode totals must be in 4..4095 / 2..4095");
+  begin : g_bad_test_total
+    $fatal(1, "de_video_timing: test mode totals must be in 4..4095 / 2..4095");
   end
 
   // Mode table (docs/display-controller.md §3).
@@ -146,3 +148,5 @@ module de_video_timing #(
   assign next_active_o = (next_line_o < v_act);
 
 endmodule
+
+`default_nettype wire

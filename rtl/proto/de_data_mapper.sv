@@ -3,6 +3,8 @@
 // instruction (12-bit identifier + 36-bit 12.24 data) for a 6-bit DAC window at pixel
 // bits [w+5:w], w = 0..4, and optionally applies the carry-bug compensation.
 // One registered stage; the reference model is diffengine.binfmt.map_word.
+`default_nettype none
+
 module de_data_mapper (
   input  logic        clk_i,
   input  logic        rst_i,
@@ -11,7 +13,7 @@ module de_data_mapper (
   input  logic [2:0]  window_i,      // w: the DAC window's lowest pixel bit, 0..4
   input  logic        compensate_i,  // apply the 7.7 carry-bug compensation
   output logic        valid_o,
-  output logic [11:0] ident_o,
+  output logic [11:0] id_o,
   output logic [35:0] data_o
 );
   logic [11:0] ident;
@@ -24,7 +26,7 @@ module de_data_mapper (
 
   de_instr_lut u_lut (
     .code_i  (word_i[31:27]),
-    .ident_o (ident),
+    .id_o (ident),
     .type_o  (op_type)
   );
 
@@ -71,6 +73,8 @@ module de_data_mapper (
   end
 
   assign valid_o = valid_q;
-  assign ident_o = ident_q;
+  assign id_o = ident_q;
   assign data_o  = data_q;
 endmodule
+
+`default_nettype wire

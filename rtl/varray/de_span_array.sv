@@ -30,6 +30,8 @@
 // command, so one register captured per pass is the per-column flag of the plain array.
 // Reset: rst_i for one clock; bank 0 is then cleared through the pipeline and bank 1 by
 // the drain (NumCols clocks, busy_o high) before the first pass is issued.
+`default_nettype none
+
 module de_span_array
   import de_pkg::*;
 #(
@@ -41,11 +43,11 @@ module de_span_array
   input  logic             rst_i,
   input  logic             instr_valid_i,
   output logic             instr_ready_o,
-  input  logic [IdW-1:0]   ident_i,
+  input  logic [IdW-1:0]   id_i,
   input  logic [DataW-1:0] data_i,
-  output logic             pixel_valid_o,
-  output logic [PixW-1:0]  pixel_o,
-  output logic [11:0]      pixel_col_o,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
+  output logic [11:0]      pix_col_o,
   output logic             busy_o         // passes queued or in flight, or clearing
 );
   localparam int unsigned K    = MaxSlots;
@@ -109,7 +111,7 @@ module de_span_array
 
   // ==== front end: slots -> pass table ====================================================
   id_t id;
-  assign id = id_t'(ident_i);
+  assign id = id_t'(id_i);
 
   // Pass table. The header fields travel in the token (read once, at issue); slot j is
   // read only by stage j+1, so each slot column is its own small memory with one read
@@ -628,10 +630,12 @@ module de_span_array
     end
   end
 
-  assign pixel_valid_o = pixv_q;
-  assign pixel_o       = pix_q;
-  assign pixel_col_o   = pixc_q;
+  assign pix_valid_o = pixv_q;
+  assign pix_o       = pix_q;
+  assign pix_col_o   = pixc_q;
   assign busy_o        = scrub_q || run_q || drain_busy || (wr_cnt_q != ret_cnt_q) ||
                          (iss_cnt_q != wr_cnt_q);
 
 endmodule
+
+`default_nettype wire

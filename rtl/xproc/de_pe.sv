@@ -10,6 +10,8 @@
 // that. The 36-bit add is three 12-bit adds, one per stage, with registered block
 // carries: no carry ripples through more than 12 bits in one cycle.
 
+`default_nettype none
+
 module de_pe
   import de_pkg::*;
 #(
@@ -406,3 +408,5 @@ module de_pe
                   pixv_q, pix_q};
 
 endmodule
+
+`default_nettype wire

@@ -198,7 +198,9 @@ package de_pkg;
   // AddCarryBlk.
   function automatic logic [BlkW:0] blk_carry_in(input logic c, input int unsigned blk,
                                                 input bit carry_bug);
-    if (carry_bug && blk == AddCarryBlk) return (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);
+    if (carry_bug && blk == AddCarryBlk) begin
+      return (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);
+    end
     return (BlkW + 1)'(c);
   endfunction
 
@@ -214,10 +216,21 @@ package de_pkg;
   // its geometry comes from de_video_timing's parameters.
   function automatic video_mode_t video_mode(input logic [1:0] m);
     case (m)
-      2'd0: return '{12'd640, 12'd16, 12'd96, 12'd48, 12'd480, 12'd10, 12'd2, 12'd33, 1'b0, 1'b0};  // 640x480@60 (VESA DMT, 25.175 MHz, 800x525)
-      2'd1: return '{12'd640, 12'd8, 12'd24, 12'd11, 12'd485, 12'd11, 12'd2, 12'd27, 1'b0, 1'b0};  // 640x485 low resolution of section 7.4.5 (21.5 MHz, 683x525, 59.96 Hz)
-      2'd2: return '{12'd1280, 12'd48, 12'd112, 12'd248, 12'd1024, 12'd1, 12'd3, 12'd38, 1'b1, 1'b1};  // 1280x1024@60 (VESA DMT, 108 MHz, 1688x1066)
-      default: return '{12'd640, 12'd16, 12'd96, 12'd48, 12'd480, 12'd10, 12'd2, 12'd33, 1'b0, 1'b0};
+      // 640x480@60 (VESA DMT, 25.175 MHz, 800x525)
+      2'd0: return '{12'd640, 12'd16, 12'd96, 12'd48,
+                     12'd480, 12'd10, 12'd2, 12'd33,
+                     1'b0, 1'b0};
+      // 640x485 low resolution of section 7.4.5 (21.5 MHz, 683x525, 59.96 Hz)
+      2'd1: return '{12'd640, 12'd8, 12'd24, 12'd11,
+                     12'd485, 12'd11, 12'd2, 12'd27,
+                     1'b0, 1'b0};
+      // 1280x1024@60 (VESA DMT, 108 MHz, 1688x1066)
+      2'd2: return '{12'd1280, 12'd48, 12'd112, 12'd248,
+                     12'd1024, 12'd1, 12'd3, 12'd38,
+                     1'b1, 1'b1};
+      default: return '{12'd640, 12'd16, 12'd96, 12'd48,
+                     12'd480, 12'd10, 12'd2, 12'd33,
+                     1'b0, 1'b0};
     endcase
   endfunction
 

@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
 
     Vflat& f = *flat;
     f.rst_i = in.rst;
-    f.ident_i = in.ident;
+    f.id_i = in.ident;
     f.data_i = in.data;
     f.cfg_mode_i = in.cfg_mode;
     f.cfg_bit_i = in.cfg_bit;
@@ -91,9 +91,9 @@ int main(int argc, char** argv) {
     f.eval();
     const de_fast::Out o = fast.step(in);
     stats_pix += o.pixel_valid;
-    const bool same = o.ident == f.ident_o && o.data == f.data_o &&
-                      o.pixel_valid == static_cast<bool>(f.pixel_valid_o) &&
-                      o.pixel == f.pixel_o && o.collision == static_cast<bool>(f.pix_collision_o) &&
+    const bool same = o.ident == f.id_o && o.data == f.data_o &&
+                      o.pixel_valid == static_cast<bool>(f.pix_valid_o) &&
+                      o.pixel == f.pix_o && o.collision == static_cast<bool>(f.pix_collision_o) &&
                       o.cfg_bit == static_cast<bool>(f.cfg_bit_o) &&
                       o.obs_bit == static_cast<bool>(f.obs_bit_o);
     if (!same) {
@@ -101,8 +101,8 @@ int main(int argc, char** argv) {
           "equiv: DIFFERENT at cycle %lld (seed %llu)\n"
           "  flat: ident %03x data %09llx pixv %d pixel %03x coll %d cfg_bit %d obs_bit %d\n"
           "  fast: ident %03x data %09llx pixv %d pixel %03x coll %d cfg_bit %d obs_bit %d\n",
-          c, static_cast<unsigned long long>(seed), f.ident_o,
-          static_cast<unsigned long long>(f.data_o), f.pixel_valid_o, f.pixel_o,
+          c, static_cast<unsigned long long>(seed), f.id_o,
+          static_cast<unsigned long long>(f.data_o), f.pix_valid_o, f.pix_o,
           f.pix_collision_o, f.cfg_bit_o, f.obs_bit_o, o.ident,
           static_cast<unsigned long long>(o.data), o.pixel_valid, o.pixel, o.collision,
           o.cfg_bit, o.obs_bit);

@@ -366,8 +366,8 @@ bool write_gtkw(const std::string& fst, const std::vector<int>& pes, uint64_t t0
   std::string abs = fst;
   if (fst[0] != '/' && getcwd(cwd, sizeof cwd)) abs = std::string(cwd) + "/" + fst;
   std::fprintf(f, "[dumpfile] \"%s\"\n[timestart] %llu\n[size] 1800 1000\n"
-               "[sst_expanded] 0\n@28\nTOP.clk_i\n@22\nTOP.ident_i[11:0]\nTOP.data_i[35:0]\n"
-               "@28\nTOP.pixel_valid_o\n@22\nTOP.pixel_o[11:0]\n",
+               "[sst_expanded] 0\n@28\nTOP.clk_i\n@22\nTOP.id_i[11:0]\nTOP.data_i[35:0]\n"
+               "@28\nTOP.pix_valid_o\n@22\nTOP.pix_o[11:0]\n",
                abs.c_str(), static_cast<unsigned long long>(t0));
   for (int p : pes) {
     const std::string s = "TOP." + pe_scope(p) + ".";
@@ -622,8 +622,8 @@ int main(int argc, char** argv) {
                             static_cast<uint64_t>(slot)) - refresh_at.begin();
   };
 
-  // The window: --line L = from the cycle Refresh L-1 is on ident_i (cycle 0 for L = 0)
-  // to the cycle line L's last pixel is on pixel_o.
+  // The window: --line L = from the cycle Refresh L-1 is on id_i (cycle 0 for L = 0)
+  // to the cycle line L's last pixel is on pix_o.
   uint64_t w_from = 0, w_to = total ? total - 1 : 0;
   if (o.line >= 0) {
     if (static_cast<uint64_t>(o.line) >= refresh_at.size()) {
@@ -651,7 +651,7 @@ int main(int argc, char** argv) {
                    o.break_line, static_cast<long long>(refresh_at.size()) - 1);
       return 2;
     }
-    // Line L starts when its first instruction is on ident_i.
+    // Line L starts when its first instruction is on id_i.
     const uint64_t c = o.break_line ? refresh_at[o.break_line - 1] + 1 : 0;
     break_at = std::min(break_at, c);
   }
@@ -721,7 +721,7 @@ int main(int argc, char** argv) {
     top->eval();
   };
   top->rst_i = 1;
-  top->ident_i = 0;
+  top->id_i = 0;
   top->data_i = 0;
   top->cfg_mode_i = 0;
   top->cfg_bit_i = 0;
@@ -792,7 +792,7 @@ int main(int argc, char** argv) {
   for (int r = 0; r < o.repeat; ++r) {
     for (uint64_t i = r == 0 ? first_i : 0; i < play; ++i, ++cycle) {
       const Instr& in = seq[i];
-      top->ident_i = in.ident;
+      top->id_i = in.ident;
       top->data_i = in.data;
 #ifdef DE_TRACE
       if (slow) {
@@ -814,7 +814,7 @@ int main(int argc, char** argv) {
         }
         if (stop) {
           const long long line = line_of_slot(static_cast<long long>(cycle));
-          std::printf("break: cycle %llu, line %lld (of the instruction on ident_i)",
+          std::printf("break: cycle %llu, line %lld (of the instruction on id_i)",
                       static_cast<unsigned long long>(cycle), line);
           if (brk_probe)
             std::printf(", PE %d (column %d) receives identifier 0x%03x",
@@ -847,10 +847,10 @@ int main(int argc, char** argv) {
 #else
       tick();
 #endif
-      if (top->pixel_valid_o && r == 0) pixels.push_back(top->pixel_o);
-      if (o.trace_pixels && top->pixel_valid_o)
+      if (top->pix_valid_o && r == 0) pixels.push_back(top->pix_o);
+      if (o.trace_pixels && top->pix_valid_o)
         std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(cycle + 1),
-                    pixels.size() - 1, top->pixel_o);
+                    pixels.size() - 1, top->pix_o);
       if (o.trace_pixels && in.ident == kRefresh)
         std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(cycle + 1));
       if (top->pix_collision_o && !collided) {

@@ -64,7 +64,7 @@ class Array:
 
     async def reset(self):
         d = self.dut
-        for sig in (d.ident_i, d.data_i, d.cfg_mode_i, d.cfg_bit_i, d.obs_load_i,
+        for sig in (d.id_i, d.data_i, d.cfg_mode_i, d.cfg_bit_i, d.obs_load_i,
                     d.obs_shift_i):
             sig.value = 0
         d.rst_i.value = 1
@@ -91,15 +91,15 @@ class Array:
     async def play(self, slots):
         d = self.dut
         for ident, data in slots:
-            d.ident_i.value = ident
+            d.id_i.value = ident
             d.data_i.value = data
             await RisingEdge(d.clk_i)
             await ReadOnly()
             self.edge += 1
             if ident == isa.REFRESH:
                 self.refresh_edges.append(self.edge)
-            if int(d.pixel_valid_o.value):
-                self.pixels.append(int(d.pixel_o.value))
+            if int(d.pix_valid_o.value):
+                self.pixels.append(int(d.pix_o.value))
                 self.pixel_edges.append(self.edge)
             if self.model:
                 self.model.step(ident, data)
@@ -175,8 +175,8 @@ async def directed_boundaries(dut):
     await arr.play(spaced(isa.serialise(cmds), n))
     want = functional.render(cmds, n, carry_bug=carry_bug(dut))
     np.testing.assert_array_equal(arr.frame(), want)
-    # docs/array.md: a Refresh on ident_i in the cycle ending with edge R puts column q
-    # on pixel_o after edge R + NumChips + 2 + q.
+    # docs/array.md: a Refresh on id_i in the cycle ending with edge R puts column q
+    # on pix_o after edge R + NumChips + 2 + q.
     k = arr.k
     for line, r in enumerate(arr.refresh_edges):
         edges = arr.pixel_edges[line * n:(line + 1) * n]
@@ -204,7 +204,7 @@ async def observation_chain(dut):
     slots = isa.serialise(cmds)[:-1]  # stop mid-stream so flags are set
     await arr.play(slots)
     d = dut
-    d.ident_i.value, d.data_i.value = 0, 0
+    d.id_i.value, d.data_i.value = 0, 0
     d.obs_load_i.value = 1
     await RisingEdge(d.clk_i)   # the load samples the state after the last slot
     await FallingEdge(d.clk_i)

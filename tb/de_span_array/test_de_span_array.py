@@ -44,15 +44,15 @@ class Bench:
             await RisingEdge(d.clk_i)
             await ReadOnly()
             self.cycle += 1
-            if int(d.pixel_valid_o.value):
-                self.pixels.append((int(d.pixel_col_o.value), int(d.pixel_o.value)))
+            if int(d.pix_valid_o.value):
+                self.pixels.append((int(d.pix_col_o.value), int(d.pix_o.value)))
                 if len(self.pixels) % self.n == 0:
                     self.refresh_cycles.append(self.cycle)
 
     async def reset(self):
         d = self.dut
         d.instr_valid_i.value = 0
-        d.ident_i.value = 0
+        d.id_i.value = 0
         d.data_i.value = 0
         d.rst_i.value = 1
         await RisingEdge(d.clk_i)
@@ -64,7 +64,7 @@ class Bench:
         returns at the falling edge after the clock that took it."""
         d = self.dut
         d.instr_valid_i.value = 1
-        d.ident_i.value = ident
+        d.id_i.value = ident
         d.data_i.value = data
         while True:
             await ReadOnly()

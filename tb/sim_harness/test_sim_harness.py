@@ -145,7 +145,7 @@ def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
     c, rows = stopped(run(exe, src, tmp_path / "o", "--break-cycle", 57, "--trace-pes",
                           "8-10", rc=3))
     assert c == 57 and rows == [by_key[("57", str(p))] for p in (8, 9, 10)]
-    # At a scanline: its first instruction is on ident_i. A dump stops there too, with
+    # At a scanline: its first instruction is on id_i. A dump stops there too, with
     # its save file.
     c, _ = stopped(run(exe, src, tmp_path / "o", "--break-line", 2, "--fst",
                        tmp_path / "b.fst", rc=3))

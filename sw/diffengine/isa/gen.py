@@ -198,7 +198,9 @@ def gen_sv(spec: dict) -> str:
           "  // AddCarryBlk.",
           "  function automatic logic [BlkW:0] blk_carry_in(input logic c, input int unsigned blk,",
           "                                                input bit carry_bug);",
-          "    if (carry_bug && blk == AddCarryBlk) return (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);",
+          "    if (carry_bug && blk == AddCarryBlk) begin",
+          "      return (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);",
+          "    end",
           "    return (BlkW + 1)'(c);",
           "  endfunction",
           "",
@@ -217,7 +219,7 @@ def gen_sv(spec: dict) -> str:
     modes = spec["video"]["mode"]
     default = next(m for m in modes if m["index"] == 0)
     for m in modes:
-        o.append(f"      2'd{m['index']}: return {sv_mode(m)};  // {m['doc']}")
+        o += [f"      // {m['doc']}", f"      2'd{m['index']}: return {sv_mode(m)};"]
     o += [f"      default: return {sv_mode(default)};", "    endcase", "  endfunction", "",
           "  // ---- de_pe's debug vector dbg_o (MSB first in spec/isa.toml) ----"]
     fields = debug_lsbs(spec)
@@ -240,8 +242,11 @@ def gen_sv(spec: dict) -> str:
 
 
 def sv_mode(m: dict) -> str:
-    vals = [f"12'd{x}" for x in m["h"] + m["v"]] + [f"1'b{int(m['hpol'])}", f"1'b{int(m['vpol'])}"]
-    return "'{" + ", ".join(vals) + "}"
+    """A video_mode_t literal, one line per direction (h, v, polarities)."""
+    h = ", ".join(f"12'd{x}" for x in m["h"])
+    v = ", ".join(f"12'd{x}" for x in m["v"])
+    pad = " " * 21  # under the first value after "      2'dN: return '{"
+    return f"'{{{h},\n{pad}{v},\n{pad}1'b{int(m['hpol'])}, 1'b{int(m['vpol'])}}}"
 
 
 # ---- C -------------------------------------------------------------------------------
