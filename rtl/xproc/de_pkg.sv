@@ -1,4 +1,4 @@
-// GENERATED FILE, DO NOT EDIT. Source: spec/isa.toml and spec/video.toml.
+// GENERATED FILE, DO NOT EDIT. Source: spec/isa.toml, spec/video.toml, spec/regs.toml.
 // Regenerate with `python -m diffengine.isa.gen` (or `make gen`); `make gen-check` diffs.
 
 `default_nettype none
@@ -90,51 +90,51 @@ package de_pkg;
   // The prototype's 5 -> 12 look-up table; unused codes decode as Nop (cannot act).
   function automatic logic [IdW-1:0] lut_ident(input logic [LutCodeW-1:0] code);
     case (code)
-      5'd0: return IdNop;
-      5'd1: return IdRefresh;
-      5'd2: return IdAccmodeOn;
-      5'd3: return IdAccmodeOff;
-      5'd4: return IdAddrRange;
-      5'd5: return IdAddrPeriodic;
-      5'd6: return IdAddrEval0;
-      5'd7: return IdAddrDis;
-      5'd8: return IdAcc;
-      5'd9: return IdDA;
-      5'd10: return IdDB;
-      5'd11: return IdDC;
-      5'd12: return IdDBC;
-      5'd13: return IdDAB;
-      5'd14: return IdDABNp;
-      5'd15: return IdDAANp;
-      5'd16: return IdSetA;
-      5'd17: return IdSetB;
-      5'd18: return IdSetC;
-      default: return IdNop;
+      5'd0: lut_ident = IdNop;
+      5'd1: lut_ident = IdRefresh;
+      5'd2: lut_ident = IdAccmodeOn;
+      5'd3: lut_ident = IdAccmodeOff;
+      5'd4: lut_ident = IdAddrRange;
+      5'd5: lut_ident = IdAddrPeriodic;
+      5'd6: lut_ident = IdAddrEval0;
+      5'd7: lut_ident = IdAddrDis;
+      5'd8: lut_ident = IdAcc;
+      5'd9: lut_ident = IdDA;
+      5'd10: lut_ident = IdDB;
+      5'd11: lut_ident = IdDC;
+      5'd12: lut_ident = IdDBC;
+      5'd13: lut_ident = IdDAB;
+      5'd14: lut_ident = IdDABNp;
+      5'd15: lut_ident = IdDAANp;
+      5'd16: lut_ident = IdSetA;
+      5'd17: lut_ident = IdSetB;
+      5'd18: lut_ident = IdSetC;
+      default: lut_ident = IdNop;
     endcase
   endfunction
 
   function automatic logic [1:0] lut_type(input logic [LutCodeW-1:0] code);
     case (code)
-      5'd0: return TypeNone;
-      5'd1: return TypeNone;
-      5'd2: return TypeNone;
-      5'd3: return TypeNone;
-      5'd4: return TypeAddress;
-      5'd5: return TypeAddress;
-      5'd6: return TypeAddress;
-      5'd7: return TypeAddress;
-      5'd8: return TypeNone;
-      5'd9: return TypeIntensity;
-      5'd10: return TypeIntensity;
-      5'd11: return TypeIntensity;
-      5'd12: return TypeIntensity;
-      5'd13: return TypeIntensity;
-      5'd14: return TypeIntensity;
-      5'd15: return TypeIntensity;
-      5'd16: return TypeIntensity;
-      5'd17: return TypeIntensity;
-      5'd18: return TypeIntensity;
-      default: return TypeNone;
+      5'd0: lut_type = TypeNone;
+      5'd1: lut_type = TypeNone;
+      5'd2: lut_type = TypeNone;
+      5'd3: lut_type = TypeNone;
+      5'd4: lut_type = TypeAddress;
+      5'd5: lut_type = TypeAddress;
+      5'd6: lut_type = TypeAddress;
+      5'd7: lut_type = TypeAddress;
+      5'd8: lut_type = TypeNone;
+      5'd9: lut_type = TypeIntensity;
+      5'd10: lut_type = TypeIntensity;
+      5'd11: lut_type = TypeIntensity;
+      5'd12: lut_type = TypeIntensity;
+      5'd13: lut_type = TypeIntensity;
+      5'd14: lut_type = TypeIntensity;
+      5'd15: lut_type = TypeIntensity;
+      5'd16: lut_type = TypeIntensity;
+      5'd17: lut_type = TypeIntensity;
+      5'd18: lut_type = TypeIntensity;
+      default: lut_type = TypeNone;
     endcase
   endfunction
 
@@ -143,34 +143,50 @@ package de_pkg;
   function automatic logic [BlkW-1:0] reg_blk(input logic [1:0] code, input logic [BlkW-1:0] a,
                                 input logic [BlkW-1:0] b, input logic [BlkW-1:0] c);
     case (code)
-      RegA:    return a;
-      RegB:    return b;
-      RegC:    return c;
-      default: return '0;
+      RegA:    reg_blk = a;
+      RegB:    reg_blk = b;
+      RegC:    reg_blk = c;
+      default: reg_blk = '0;
     endcase
   endfunction
   function automatic logic [DataW-1:0] reg_word(input logic [1:0] code, input logic [DataW-1:0] a,
                                 input logic [DataW-1:0] b, input logic [DataW-1:0] c);
     case (code)
-      RegA:    return a;
-      RegB:    return b;
-      RegC:    return c;
-      default: return '0;
+      RegA:    reg_word = a;
+      RegB:    reg_word = b;
+      RegC:    reg_word = c;
+      default: reg_word = '0;
     endcase
   endfunction
   function automatic logic reg_flag(input logic [1:0] code, input logic a,
                                 input logic b, input logic c);
     case (code)
-      RegA:    return a;
-      RegB:    return b;
-      RegC:    return c;
-      default: return 1'b0;
+      RegA:    reg_flag = a;
+      RegB:    reg_flag = b;
+      RegC:    reg_flag = c;
+      default: reg_flag = 1'b0;
     endcase
+  endfunction
+  // One instruction as the y-processor and the controller store it: {identifier, data}.
+  localparam int unsigned RecW = IdW + DataW;
+  // Each reads one half of the record.
+  /* verilator lint_off UNUSEDSIGNAL */
+  function automatic logic [IdW-1:0] rec_id(input logic [RecW-1:0] r);
+    rec_id = r[RecW-1 -: IdW];
+  endfunction
+  function automatic logic [DataW-1:0] rec_data(input logic [RecW-1:0] r);
+    rec_data = r[DataW-1:0];
+  endfunction
+  /* verilator lint_on UNUSEDSIGNAL */
+  // A command starts with a slot that is neither DATA nor ACC (an address slot,
+  // Refresh, Acc_mode or Nop): the controller cuts the stream only there.
+  function automatic logic id_starts_cmd(input logic [IdW-1:0] id);
+    id_starts_cmd = !id[IdDataBit] && !id[IdAccBit];
   endfunction
   // Block i of a data word (block 0 = the low 12 bits; the pixel is block 2).
   function automatic logic [BlkW-1:0] word_blk(input logic [DataW-1:0] w,
                                                input int unsigned i);
-    return w[i*BlkW +: BlkW];
+    word_blk = w[i*BlkW +: BlkW];
   endfunction
 
   // ---- the adder (isa.md section 7) ----
@@ -186,11 +202,11 @@ package de_pkg;
                                                 input bit carry_bug);
     logic [AddCarryFrom:0]       lo;
     logic [DataW-AddCarryFrom-1:0] hi;
-    if (!carry_bug) return x + y;
     lo = {1'b0, x[AddCarryFrom-1:0]} + {1'b0, y[AddCarryFrom-1:0]};
     hi = x[DataW-1:AddCarryFrom] + y[DataW-1:AddCarryFrom]
        + ((DataW - AddCarryFrom)'(lo[AddCarryFrom]) << (AddCarryTo - AddCarryFrom));
-    return {hi, lo[AddCarryFrom-1:0]};
+    // One carry chain without the fault: the fault's form puts two in series.
+    add_word = carry_bug ? {hi, lo[AddCarryFrom-1:0]} : x + y;
   endfunction
 
   // The block-carry form (de_pe): weight of a registered block carry as it enters
@@ -198,10 +214,10 @@ package de_pkg;
   // AddCarryBlk.
   function automatic logic [BlkW:0] blk_carry_in(input logic c, input int unsigned blk,
                                                 input bit carry_bug);
+    blk_carry_in = (BlkW + 1)'(c);
     if (carry_bug && blk == AddCarryBlk) begin
-      return (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);
+      blk_carry_in = (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);
     end
-    return (BlkW + 1)'(c);
   endfunction
 
   // ---- video modes (spec/video.toml) ----
@@ -217,20 +233,20 @@ package de_pkg;
   function automatic video_mode_t video_mode(input logic [1:0] m);
     case (m)
       // 640x480@60 (VESA DMT, 25.175 MHz, 800x525)
-      2'd0: return '{12'd640, 12'd16, 12'd96, 12'd48,
-                     12'd480, 12'd10, 12'd2, 12'd33,
-                     1'b0, 1'b0};
+      2'd0: video_mode = {12'd640, 12'd16, 12'd96, 12'd48,
+                         12'd480, 12'd10, 12'd2, 12'd33,
+                         1'b0, 1'b0};
       // 640x485 low resolution of section 7.4.5 (21.5 MHz, 683x525, 59.96 Hz)
-      2'd1: return '{12'd640, 12'd8, 12'd24, 12'd11,
-                     12'd485, 12'd11, 12'd2, 12'd27,
-                     1'b0, 1'b0};
+      2'd1: video_mode = {12'd640, 12'd8, 12'd24, 12'd11,
+                         12'd485, 12'd11, 12'd2, 12'd27,
+                         1'b0, 1'b0};
       // 1280x1024@60 (VESA DMT, 108 MHz, 1688x1066)
-      2'd2: return '{12'd1280, 12'd48, 12'd112, 12'd248,
-                     12'd1024, 12'd1, 12'd3, 12'd38,
-                     1'b1, 1'b1};
-      default: return '{12'd640, 12'd16, 12'd96, 12'd48,
-                     12'd480, 12'd10, 12'd2, 12'd33,
-                     1'b0, 1'b0};
+      2'd2: video_mode = {12'd1280, 12'd48, 12'd112, 12'd248,
+                         12'd1024, 12'd1, 12'd3, 12'd38,
+                         1'b1, 1'b1};
+      default: video_mode = {12'd640, 12'd16, 12'd96, 12'd48,
+                         12'd480, 12'd10, 12'd2, 12'd33,
+                         1'b0, 1'b0};
     endcase
   endfunction
 
@@ -265,11 +281,32 @@ package de_pkg;
   localparam int unsigned DbgPixLsb = 0;
   localparam int unsigned DbgW = 236;
 
+  // ---- host register map (spec/regs.toml) ----
+  localparam int unsigned RegChanLsb = 12;  // address bits above it: the channel
+  localparam logic [1:0] RegInfoChan = 2'h3;  // channel of the controller's registers
+  localparam logic [7:0] LmIdMagic = 8'hDE;  // Load Monitor ID[31:24]
+  localparam logic [7:0] CtrlIdMagic = 8'hDC;  // controller ID[31:24]
+  localparam logic [11:0] LmRegId = 12'h000;  // Load Monitor register
+  localparam logic [11:0] LmRegFrames = 12'h001;  // Load Monitor register
+  localparam logic [11:0] LmRegIssued = 12'h002;  // Load Monitor register
+  localparam logic [11:0] LmRegFree = 12'h003;  // Load Monitor register
+  localparam logic [11:0] LmRegLate = 12'h004;  // Load Monitor register
+  localparam logic [11:0] LmRegDrop = 12'h005;  // Load Monitor register
+  localparam logic [11:0] LmRegMaxIssued = 12'h006;  // Load Monitor register
+  localparam logic [11:0] LmRegLastLine = 12'h007;  // Load Monitor register
+  localparam logic [11:0] LmRegLastRec = 12'h008;  // Load Monitor register
+  localparam logic [11:0] LmRegTotalDrop = 12'h009;  // Load Monitor register
+  localparam logic [11:0] LmRegTotalLate = 12'h00A;  // Load Monitor register
+  localparam logic [11:0] LmHistBase = 12'h040;  // HIST[b] at LM_HIST_BASE + b
+  localparam logic [11:0] LmLineBase = 12'h400;  // LINE[l] at LM_LINE_BASE + l
+  localparam logic [11:0] CtrlRegId = 12'h000;  // controller register
+  localparam logic [11:0] CtrlRegAlignErr = 12'h001;  // controller register
+
   // Elaboration-time check that id_t and the bit positions above agree (used by de_pe).
   function automatic bit id_layout_ok();
     id_t t;
     bit  ok;
-    ok = ($bits(id_t) == IdW);
+    ok = ($bits(t) == IdW);
     t = '0; t.addr = 1'b1; ok &= (IdW'(t) == IdW'(1) << IdAddrBit);
     t = '0; t.data = 1'b1; ok &= (IdW'(t) == IdW'(1) << IdDataBit);
     t = '0; t.acc = 1'b1; ok &= (IdW'(t) == IdW'(1) << IdAccBit);
@@ -279,7 +316,7 @@ package de_pkg;
     t = '0; t.set = 1'b1; ok &= (IdW'(t) == IdW'(1) << IdSetBit);
     t = '0; t.prot = 1'b1; ok &= (IdW'(t) == IdW'(1) << IdProtBit);
     t = '0; t.sub = 2'd1; ok &= (IdW'(t) == IdW'(1) << IdSubLsb);
-    return ok;
+    id_layout_ok = ok;
   endfunction
 
   /* verilator lint_on UNUSEDPARAM */

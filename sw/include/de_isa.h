@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT. Source: spec/isa.toml and spec/video.toml.
+/* GENERATED FILE, DO NOT EDIT. Source: spec/isa.toml, spec/video.toml, spec/regs.toml.
  * Regenerate with `python -m diffengine.isa.gen` (or `make gen`); `make gen-check` diffs. */
 /* de_isa.h - the x-processor instruction set for C and C++ (sw/hsr, sim/harness):
  * identifiers, field positions, the adder with its carry-bug model, the look-up
@@ -197,5 +197,26 @@ static inline int de_video_vtotal(const de_video_mode *m)
 #define DE_DBG_PIX_VALID_LSB 12
 #define DE_DBG_PIX_LSB 0
 #define DE_DBG_BITS 236
+
+/* The host register map (spec/regs.toml). */
+#define DE_REG_CHAN_LSB 0x00cu  /* address bits above it: the channel */
+#define DE_REG_INFO_CHAN 0x003u  /* channel of the controller's registers */
+#define DE_LM_ID_MAGIC 0x0deu  /* Load Monitor ID[31:24] */
+#define DE_CTRL_ID_MAGIC 0x0dcu  /* controller ID[31:24] */
+#define DE_LM_REG_ID 0x000u  /* Load Monitor register */
+#define DE_LM_REG_FRAMES 0x001u  /* Load Monitor register */
+#define DE_LM_REG_ISSUED 0x002u  /* Load Monitor register */
+#define DE_LM_REG_FREE 0x003u  /* Load Monitor register */
+#define DE_LM_REG_LATE 0x004u  /* Load Monitor register */
+#define DE_LM_REG_DROP 0x005u  /* Load Monitor register */
+#define DE_LM_REG_MAX_ISSUED 0x006u  /* Load Monitor register */
+#define DE_LM_REG_LAST_LINE 0x007u  /* Load Monitor register */
+#define DE_LM_REG_LAST_REC 0x008u  /* Load Monitor register */
+#define DE_LM_REG_TOTAL_DROP 0x009u  /* Load Monitor register */
+#define DE_LM_REG_TOTAL_LATE 0x00au  /* Load Monitor register */
+#define DE_LM_HIST_BASE 0x040u  /* HIST[b] at LM_HIST_BASE + b */
+#define DE_LM_LINE_BASE 0x400u  /* LINE[l] at LM_LINE_BASE + l */
+#define DE_CTRL_REG_ID 0x000u  /* controller register */
+#define DE_CTRL_REG_ALIGN_ERR 0x001u  /* controller register */
 
 #endif

@@ -1,9 +1,9 @@
 """No ISA fact is written by hand where it used to be (issue 17 item 1).
 
-spec/isa.toml and spec/video.toml are the one description; rtl/xproc/de_pkg.sv,
+spec/isa.toml, spec/video.toml and spec/regs.toml are the one description; rtl/xproc/de_pkg.sv,
 sw/include/de_isa.h and sw/diffengine/isa/_tables.py are generated from them. This test
 greps the files that used to hold their own copies (identifier encodings, field offsets,
-video timings) for those literals and fails naming file:line, so a copy cannot come back
+video timings, the host register map of spec/regs.toml) for those literals and fails naming file:line, so a copy cannot come back
 unnoticed. A line may opt out with the marker `isa-literal-ok` and a reason.
 """
 from __future__ import annotations
@@ -25,10 +25,13 @@ SV_FIELD = re.compile(r"\[(?:35|23):(?:24|0)\]")
 VIDEO = re.compile(r"\b(?:683|1688)\b|\b16,\s*96\b|\b8,\s*24,\s*11\b|\b48,\s*112\b"
                    r"|12'd(?:96|112|248|485)\b")
 
+# The host register map (spec/regs.toml): register numbers, window bases, ID magics.
+REGS = re.compile(r"\b0x300[01]\b|\brd\(base \+ (?:0x[0-9a-f]+|\d+)|\b0xD[CE]\b", re.I)
+
 PLACES: list[tuple[str, tuple[re.Pattern, ...]]] = [
     ("sw/hsr/src/yp_emit.c", (ID_HEX, SHIFT, VIDEO)),
     ("sim/harness/array_harness.cpp", (ID_HEX, SHIFT)),
-    ("sim/dc/dc_harness.cpp", (ID_HEX, VIDEO)),
+    ("sim/dc/dc_harness.cpp", (ID_HEX, VIDEO, REGS, SHIFT)),
     ("sim/fast/equiv.cpp", (ID_HEX,)),
     ("rtl/xproc/de_pe.sv", (ID_SV, SV_FIELD)),
     ("rtl/varray/de_span_array.sv", (ID_SV, SV_FIELD)),
@@ -65,7 +68,7 @@ def stray(root: Path = ROOT) -> list[str]:
                 m = pat.search(code)
                 if m:
                     found.append(f"{rel}:{n}: {m.group(0)!r} is written by hand; use the "
-                                 "generated name (spec/isa.toml, spec/video.toml)")
+                                 "generated name (spec/*.toml)")
     return found
 
 

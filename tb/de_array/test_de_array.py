@@ -210,7 +210,12 @@ async def observation_chain(dut):
     await FallingEdge(d.clk_i)
     d.obs_load_i.value = 0
     d.obs_shift_i.value = 1
-    obs_w = 31
+    flag_names = ("pA", "pB", "pC", "dis", "lock", "acc_mode", "act")
+    ctl_names = ("xz1", "act1", "prot1", "c1", "act2", "prot2", "c2", "e0wr2",
+                 "accen2", "accc2", "accen3", "accc3")
+    width = dict(st.DBG_FIELDS)
+    # The observation word: the flags, id1 and the control bits (spec/isa.toml [debug]).
+    obs_w = sum(width[n] for n in flag_names + ("id1",) + ctl_names)
     bits = []
     for _ in range(arr.n * obs_w):
         await ReadOnly()
@@ -228,13 +233,12 @@ async def observation_chain(dut):
         dbg = arr.history[t - lag][q]
         f = lambda name: (dbg >> pos[name][0]) & ((1 << pos[name][1]) - 1)  # noqa: E731
         flags = 0
-        for name in ("pA", "pB", "pC", "dis", "lock", "acc_mode", "act"):
+        for name in flag_names:
             flags = (flags << 1) | f(name)
         ctl = 0
-        for name in ("xz1", "act1", "prot1", "c1", "act2", "prot2", "c2", "e0wr2",
-                     "accen2", "accc2", "accen3", "accc3"):
+        for name in ctl_names:
             ctl = (ctl << 1) | f(name)
-        want = (((flags << 12) | f("id1")) << 12) | ctl
+        want = (((flags << width["id1"]) | f("id1")) << len(ctl_names)) | ctl
         assert word == want, f"PE {q}: observed {word:#010x}, model {want:#010x}"
 
 

@@ -1,4 +1,4 @@
-# GENERATED FILE, DO NOT EDIT. Source: spec/isa.toml and spec/video.toml.
+# GENERATED FILE, DO NOT EDIT. Source: spec/isa.toml, spec/video.toml, spec/regs.toml.
 # Regenerate with `python -m diffengine.isa.gen` (or `make gen`); `make gen-check` diffs.
 """The ISA tables of spec/isa.toml and spec/video.toml (imported by diffengine.isa)."""
 from __future__ import annotations
@@ -98,6 +98,27 @@ LUT: list[tuple[str, int, str]] = [
     ("SET_B", SET_B, TYPE_INT),
     ("SET_C", SET_C, TYPE_INT),
 ]
+
+# The host register map (spec/regs.toml).
+REG_CHAN_LSB = 0x00c  # address bits above it: the channel
+REG_INFO_CHAN = 0x003  # channel of the controller's registers
+LM_ID_MAGIC = 0x0de  # Load Monitor ID[31:24]
+CTRL_ID_MAGIC = 0x0dc  # controller ID[31:24]
+LM_REG_ID = 0x000  # Load Monitor register
+LM_REG_FRAMES = 0x001  # Load Monitor register
+LM_REG_ISSUED = 0x002  # Load Monitor register
+LM_REG_FREE = 0x003  # Load Monitor register
+LM_REG_LATE = 0x004  # Load Monitor register
+LM_REG_DROP = 0x005  # Load Monitor register
+LM_REG_MAX_ISSUED = 0x006  # Load Monitor register
+LM_REG_LAST_LINE = 0x007  # Load Monitor register
+LM_REG_LAST_REC = 0x008  # Load Monitor register
+LM_REG_TOTAL_DROP = 0x009  # Load Monitor register
+LM_REG_TOTAL_LATE = 0x00a  # Load Monitor register
+LM_HIST_BASE = 0x040  # HIST[b] at LM_HIST_BASE + b
+LM_LINE_BASE = 0x400  # LINE[l] at LM_LINE_BASE + l
+CTRL_REG_ID = 0x000  # controller register
+CTRL_REG_ALIGN_ERR = 0x001  # controller register
 
 ADD_CARRY_FROM = 24
 ADD_CARRY_TO = 25

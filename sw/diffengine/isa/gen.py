@@ -19,7 +19,7 @@ import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[3]
-SPEC = ("spec/isa.toml", "spec/video.toml")
+SPEC = ("spec/isa.toml", "spec/video.toml", "spec/regs.toml")
 SV_OUT = "rtl/xproc/de_pkg.sv"
 C_OUT = "sw/include/de_isa.h"
 PY_OUT = "sw/diffengine/isa/_tables.py"
@@ -31,6 +31,8 @@ def load(root: Path = ROOT) -> dict:
         spec = tomllib.load(f)
     with open(root / SPEC[1], "rb") as f:
         spec["video"] = tomllib.load(f)
+    with open(root / SPEC[2], "rb") as f:
+        spec["regs"] = tomllib.load(f)
     check(spec)
     return spec
 
@@ -96,8 +98,23 @@ def code_lines(spec: dict, fmt: str, groups) -> list[str]:
     return [fmt.format(p=p, k=k.upper(), v=v) for p, g in groups for k, v in spec[g].items()]
 
 
+def reg_map(spec: dict) -> list[tuple[str, int, int, str]]:
+    """The host register map as (NAME, value, width in bits, comment), for every language."""
+    r = spec["regs"]
+    lm, ct = r["load_monitor"], r["controller"]
+    out = [("REG_CHAN_LSB", r["address"]["channel_lsb"], 0, "address bits above it: the channel"),
+           ("REG_INFO_CHAN", r["address"]["info_channel"], 2, "channel of the controller's registers"),
+           ("LM_ID_MAGIC", lm["id_magic"], 8, "Load Monitor ID[31:24]"),
+           ("CTRL_ID_MAGIC", ct["id_magic"], 8, "controller ID[31:24]")]
+    out += [(f"LM_REG_{k.upper()}", v, 12, "Load Monitor register") for k, v in lm["reg"].items()]
+    out += [("LM_HIST_BASE", lm["hist_base"], 12, "HIST[b] at LM_HIST_BASE + b"),
+            ("LM_LINE_BASE", lm["line_base"], 12, "LINE[l] at LM_LINE_BASE + l")]
+    out += [(f"CTRL_REG_{k.upper()}", v, 12, "controller register") for k, v in ct["reg"].items()]
+    return out
+
+
 def header(comment: str) -> str:
-    return (f"{comment} GENERATED FILE, DO NOT EDIT. Source: {' and '.join(SPEC)}.\n"
+    return (f"{comment} GENERATED FILE, DO NOT EDIT. Source: {', '.join(SPEC)}.\n"
             f"{comment} Regenerate with `{COMMAND}` (or `make gen`); `make gen-check` diffs.\n")
 
 
@@ -150,14 +167,14 @@ def gen_sv(spec: dict) -> str:
           "  function automatic logic [IdW-1:0] lut_ident(input logic [LutCodeW-1:0] code);",
           "    case (code)"]
     for i, (name, _, _) in enumerate(lut(spec)):
-        o.append(f"      {cw}'d{i}: return Id{camel(name)};")
-    o += ["      default: return IdNop;", "    endcase", "  endfunction", "",
+        o.append(f"      {cw}'d{i}: lut_ident = Id{camel(name)};")
+    o += ["      default: lut_ident = IdNop;", "    endcase", "  endfunction", "",
           "  function automatic logic [1:0] lut_type(input logic [LutCodeW-1:0] code);",
           "    case (code)"]
     types = {"none": "TypeNone", "address": "TypeAddress", "intensity": "TypeIntensity"}
     for i, (_, _, t) in enumerate(lut(spec)):
-        o.append(f"      {cw}'d{i}: return {types[t]};")
-    o += ["      default: return TypeNone;", "    endcase", "  endfunction", "",
+        o.append(f"      {cw}'d{i}: lut_type = {types[t]};")
+    o += ["      default: lut_type = TypeNone;", "    endcase", "  endfunction", "",
           "  // ---- field selects ----",
           "  // Register read port: code RegNone reads as zero (\"adds 0\"); one block, a word, a flag."]
     for fn, typ in (("reg_blk", "logic [BlkW-1:0]"), ("reg_word", "logic [DataW-1:0]"),
@@ -165,13 +182,29 @@ def gen_sv(spec: dict) -> str:
         zero = "1'b0" if typ == "logic" else "'0"
         o += [f"  function automatic {typ} {fn}(input logic [1:0] code, input {typ} a,",
               f"                                input {typ} b, input {typ} c);",
-              "    case (code)", "      RegA:    return a;", "      RegB:    return b;",
-              "      RegC:    return c;", f"      default: return {zero};", "    endcase",
+              "    case (code)", f"      RegA:    {fn} = a;", f"      RegB:    {fn} = b;",
+              f"      RegC:    {fn} = c;", f"      default: {fn} = {zero};", "    endcase",
               "  endfunction"]
-    o += ["  // Block i of a data word (block 0 = the low 12 bits; the pixel is block 2).",
+    o += ["  // One instruction as the y-processor and the controller store it: {identifier, data}.",
+          "  localparam int unsigned RecW = IdW + DataW;",
+          "  // Each reads one half of the record.",
+          "  /* verilator lint_off UNUSEDSIGNAL */",
+          "  function automatic logic [IdW-1:0] rec_id(input logic [RecW-1:0] r);",
+          "    rec_id = r[RecW-1 -: IdW];",
+          "  endfunction",
+          "  function automatic logic [DataW-1:0] rec_data(input logic [RecW-1:0] r);",
+          "    rec_data = r[DataW-1:0];",
+          "  endfunction",
+          "  /* verilator lint_on UNUSEDSIGNAL */",
+          "  // A command starts with a slot that is neither DATA nor ACC (an address slot,",
+          "  // Refresh, Acc_mode or Nop): the controller cuts the stream only there.",
+          "  function automatic logic id_starts_cmd(input logic [IdW-1:0] id);",
+          "    id_starts_cmd = !id[IdDataBit] && !id[IdAccBit];",
+          "  endfunction",
+          "  // Block i of a data word (block 0 = the low 12 bits; the pixel is block 2).",
           "  function automatic logic [BlkW-1:0] word_blk(input logic [DataW-1:0] w,",
           "                                               input int unsigned i);",
-          "    return w[i*BlkW +: BlkW];",
+          "    word_blk = w[i*BlkW +: BlkW];",
           "  endfunction",
           "", "  // ---- the adder (isa.md section 7) ----",
           "  // With the prototype's carry fault the carry out of the fraction enters the integer",
@@ -186,11 +219,11 @@ def gen_sv(spec: dict) -> str:
           "                                                input bit carry_bug);",
           "    logic [AddCarryFrom:0]       lo;",
           "    logic [DataW-AddCarryFrom-1:0] hi;",
-          "    if (!carry_bug) return x + y;",
           "    lo = {1'b0, x[AddCarryFrom-1:0]} + {1'b0, y[AddCarryFrom-1:0]};",
           "    hi = x[DataW-1:AddCarryFrom] + y[DataW-1:AddCarryFrom]",
           "       + ((DataW - AddCarryFrom)'(lo[AddCarryFrom]) << (AddCarryTo - AddCarryFrom));",
-          "    return {hi, lo[AddCarryFrom-1:0]};",
+          "    // One carry chain without the fault: the fault's form puts two in series.",
+          "    add_word = carry_bug ? {hi, lo[AddCarryFrom-1:0]} : x + y;",
           "  endfunction",
           "",
           "  // The block-carry form (de_pe): weight of a registered block carry as it enters",
@@ -198,10 +231,10 @@ def gen_sv(spec: dict) -> str:
           "  // AddCarryBlk.",
           "  function automatic logic [BlkW:0] blk_carry_in(input logic c, input int unsigned blk,",
           "                                                input bit carry_bug);",
+          "    blk_carry_in = (BlkW + 1)'(c);",
           "    if (carry_bug && blk == AddCarryBlk) begin",
-          "      return (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);",
+          "      blk_carry_in = (BlkW + 1)'(c) << (AddCarryTo - AddCarryFrom);",
           "    end",
-          "    return (BlkW + 1)'(c);",
           "  endfunction",
           "",
           "  // ---- video modes (spec/video.toml) ----",
@@ -219,34 +252,40 @@ def gen_sv(spec: dict) -> str:
     modes = spec["video"]["mode"]
     default = next(m for m in modes if m["index"] == 0)
     for m in modes:
-        o += [f"      // {m['doc']}", f"      2'd{m['index']}: return {sv_mode(m)};"]
-    o += [f"      default: return {sv_mode(default)};", "    endcase", "  endfunction", "",
+        o += [f"      // {m['doc']}", f"      2'd{m['index']}: video_mode = {sv_mode(m)};"]
+    o += [f"      default: video_mode = {sv_mode(default)};", "    endcase", "  endfunction", "",
           "  // ---- de_pe's debug vector dbg_o (MSB first in spec/isa.toml) ----"]
     fields = debug_lsbs(spec)
     for name, lsb, _ in fields:
         o.append(f"  localparam int unsigned Dbg{camel(name)}Lsb = {lsb};")
     o.append(f"  localparam int unsigned DbgW = {sum(wd for _, _, wd in fields)};")
+    o += ["", "  // ---- host register map (spec/regs.toml) ----"]
+    for name, val, width, doc in reg_map(spec):
+        typ = "int unsigned" if width == 0 else f"logic [{width - 1}:0]"
+        lit = str(val) if width == 0 else f"{width}'h{val:0{(width + 3) // 4}X}"
+        o.append(f"  localparam {typ} {camel(name)} = {lit};  // {doc}")
     o += ["",
           "  // Elaboration-time check that id_t and the bit positions above agree (used by de_pe).",
           "  function automatic bit id_layout_ok();",
           "    id_t t;",
           "    bit  ok;",
-          "    ok = ($bits(id_t) == IdW);"]
+          "    ok = ($bits(t) == IdW);"]
     for f in spec["id_field"]:
         suffix = "Bit" if f["width"] == 1 else "Lsb"
         val = "1'b1" if f["width"] == 1 else f"{f['width']}'d1"
         o.append(f"    t = '0; t.{f['name']} = {val}; ok &= (IdW'(t) == IdW'(1) << Id{camel(f['name'])}{suffix});")
-    o += ["    return ok;", "  endfunction", "", "  /* verilator lint_on UNUSEDPARAM */", "",
+    o += ["    id_layout_ok = ok;", "  endfunction", "", "  /* verilator lint_on UNUSEDPARAM */", "",
           "endpackage", "", "`default_nettype wire", ""]
     return "\n".join(o)
 
 
 def sv_mode(m: dict) -> str:
-    """A video_mode_t literal, one line per direction (h, v, polarities)."""
+    """A video_mode_t value as a concatenation (yosys's own parser has no '{...}), one line
+    per direction (h, v, polarities)."""
     h = ", ".join(f"12'd{x}" for x in m["h"])
     v = ", ".join(f"12'd{x}" for x in m["v"])
-    pad = " " * 21  # under the first value after "      2'dN: return '{"
-    return f"'{{{h},\n{pad}{v},\n{pad}1'b{int(m['hpol'])}, 1'b{int(m['vpol'])}}}"
+    pad = " " * 25  # under the first value after "      2'dN: video_mode = {"
+    return f"{{{h},\n{pad}{v},\n{pad}1'b{int(m['hpol'])}, 1'b{int(m['vpol'])}}}"
 
 
 # ---- C -------------------------------------------------------------------------------
@@ -316,7 +355,10 @@ def gen_c(spec: dict) -> str:
           "/* de_pe's debug vector dbg_o: lsb of each field. */"]
     for name, lsb, width in debug_lsbs(spec):
         o.append(f"#define DE_DBG_{name.upper()}_LSB {lsb}")
-    o += [f"#define DE_DBG_BITS {sum(wd for _, _, wd in debug_lsbs(spec))}", "", "#endif", ""]
+    o += [f"#define DE_DBG_BITS {sum(wd for _, _, wd in debug_lsbs(spec))}", "",
+          "/* The host register map (spec/regs.toml). */"]
+    o += [f"#define DE_{name} 0x{val:03x}u  /* {doc} */" for name, val, _, doc in reg_map(spec)]
+    o += ["", "#endif", ""]
     return "\n".join(o)
 
 
@@ -363,7 +405,9 @@ def gen_py(spec: dict) -> str:
           "LUT: list[tuple[str, int, str]] = ["]
     for name, _, t in lut(spec):
         o.append(f"    (\"{name}\", {name}, {tname[t]}),")
-    o += ["]", "",
+    o += ["]", "", "# The host register map (spec/regs.toml)."]
+    o += [f"{name} = 0x{val:03x}  # {doc}" for name, val, _, doc in reg_map(spec)]
+    o += ["",
           f"ADD_CARRY_FROM = {a['carry_from']}",
           f"ADD_CARRY_TO = {a['carry_to']}", "", "",
           "def add_word(x: int, y: int, carry_bug: bool = False) -> int:",
@@ -413,7 +457,7 @@ def main(argv: list[str] | None = None) -> int:
                 path.write_text(text)
                 print(f"wrote {rel}")
     if bad:
-        print(f"{bad} generated file(s) differ from {' and '.join(SPEC)}: run `{COMMAND}`", file=sys.stderr)
+        print(f"{bad} generated file(s) differ from {', '.join(SPEC)}: run `{COMMAND}`", file=sys.stderr)
     return 1 if bad else 0
 
 
