@@ -50,11 +50,11 @@ module span_top #(
       .rst_i         (rst_q),
       .instr_valid_i (in[48]),
       .instr_ready_o (outs[c][26]),
-      .id_i       (in[47:36]),
+      .id_i          (in[47:36]),
       .data_i        (in[35:0]),
-      .pix_valid_o (outs[c][25]),
-      .pix_o       (outs[c][24:13]),
-      .pix_col_o   (outs[c][12:1]),
+      .pix_valid_o   (outs[c][25]),
+      .pix_o         (outs[c][24:13]),
+      .pix_col_o     (outs[c][12:1]),
       .busy_o        (outs[c][0])
     );
   end

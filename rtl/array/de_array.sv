@@ -89,7 +89,7 @@ module de_array
 
   de_deskew u_deskew (
     .clk_i, .rst_i,
-    .id_i(id_c[NumChips]),
+    .id_i   (id_c[NumChips]),
     .blk0_i (data_c[NumChips][11:0]),
     .blk1_i (data_c[NumChips][23:12]),
     .blk2_i (data_c[NumChips][35:24]),
@@ -103,8 +103,8 @@ module de_array
     else       coll_q <= coll_d;
   end
 
-  assign pix_valid_o   = pixv_c[NumChips];
-  assign pix_o         = pix_c[NumChips];
+  assign pix_valid_o     = pixv_c[NumChips];
+  assign pix_o           = pix_c[NumChips];
   assign n_pe_o          = 16'(NumChips * NumPe);
   assign pix_collision_o = coll_q;
   assign cfg_bit_o       = cfg_c[NumChips];

@@ -166,7 +166,7 @@ module de_fs_player #(
     .window_i    (s1_win_q),
     .compensate_i(s1_comp_q),
     .valid_o     (map_v),
-    .id_o     (map_id),
+    .id_o        (map_id),
     .data_o      (map_data)
   );
 

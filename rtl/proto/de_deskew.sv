@@ -31,7 +31,7 @@ module de_deskew (
     end
   end
 
-  assign id_o = ident_q2;
+  assign id_o    = ident_q2;
   assign data_o  = {blk2_i, blk1_q, blk0_q2};
 endmodule
 

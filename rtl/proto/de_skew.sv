@@ -28,7 +28,7 @@ module de_skew (
     end
   end
 
-  assign id_o = id_i;
+  assign id_o    = id_i;
   assign blk0_o  = data_i[11:0];
   assign blk1_o  = blk1_q;
   assign blk2_o  = blk2_q2;

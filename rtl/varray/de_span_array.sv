@@ -630,9 +630,9 @@ module de_span_array
     end
   end
 
-  assign pix_valid_o = pixv_q;
-  assign pix_o       = pix_q;
-  assign pix_col_o   = pixc_q;
+  assign pix_valid_o   = pixv_q;
+  assign pix_o         = pix_q;
+  assign pix_col_o     = pixc_q;
   assign busy_o        = scrub_q || run_q || drain_busy || (wr_cnt_q != ret_cnt_q) ||
                          (iss_cnt_q != wr_cnt_q);
 

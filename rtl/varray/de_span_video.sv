@@ -102,11 +102,11 @@ module de_span_video
     .rst_i        (rst_c2_q),
     .instr_valid_i(cvalid),
     .instr_ready_o(cready),
-    .id_i      (cword[IdW+DataW-1 -: IdW]),
+    .id_i         (cword[IdW+DataW-1 -: IdW]),
     .data_i       (cword[DataW-1:0]),
-    .pix_valid_o(cpix_valid),
-    .pix_o      (cpix),
-    .pix_col_o  (cpix_col),
+    .pix_valid_o  (cpix_valid),
+    .pix_o        (cpix),
+    .pix_col_o    (cpix_col),
     .busy_o       (cbusy)
   );
 
@@ -227,8 +227,8 @@ module de_span_video
     end
   end
 
-  assign pix_valid_o = pixv_q;
-  assign pix_o       = pix_q;
+  assign pix_valid_o   = pixv_q;
+  assign pix_o         = pix_q;
   assign late_o        = late_q;
   assign overflow_o    = ovf_q;
 

@@ -69,10 +69,10 @@ module de_array
     obs_q  <= s_obs;
   end
 
-  assign id_o         = id_q;
+  assign id_o            = id_q;
   assign data_o          = data_q;
-  assign pix_valid_o   = pixv_q;
-  assign pix_o         = pix_q;
+  assign pix_valid_o     = pixv_q;
+  assign pix_o           = pix_q;
   assign n_pe_o          = 16'(NumChips * NumPe);
   assign pix_collision_o = coll_q;
   assign cfg_bit_o       = cfg_q;

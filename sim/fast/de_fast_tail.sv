@@ -30,7 +30,7 @@ module de_fast_tail
 
   de_deskew u_deskew (
     .clk_i, .rst_i,
-    .id_i(b_id),
+    .id_i   (b_id),
     .blk0_i (b_data[11:0]),
     .blk1_i (b_data[23:12]),
     .blk2_i (b_data[35:24]),

@@ -23,12 +23,12 @@ module de_input_circuit_tb (
   );
   de_skew u_skew (
     .clk_i, .rst_i, .id_i(id_o), .data_i(data_o),
-    .id_o(skew_ident_o), .blk0_o(skew_blk0_o), .blk1_o(skew_blk1_o),
+    .id_o  (skew_ident_o), .blk0_o(skew_blk0_o), .blk1_o(skew_blk1_o),
     .blk2_o(skew_blk2_o)
   );
   de_deskew u_deskew (
     .clk_i, .rst_i, .id_i(skew_ident_o), .blk0_i(skew_blk0_o),
     .blk1_i(skew_blk1_o), .blk2_i(skew_blk2_o),
-    .id_o(deskew_ident_o), .data_o(deskew_data_o)
+    .id_o  (deskew_ident_o), .data_o(deskew_data_o)
   );
 endmodule

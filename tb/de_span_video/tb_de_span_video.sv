@@ -26,8 +26,8 @@ module tb_de_span_video #(
 
   de_array #(.NumChips(NumChips), .CarryBug(CarryBug)) u_array (
     .clk_i, .rst_i, .id_i, .data_i,
-    .id_o(ident_out), .data_o(data_out),
-    .pix_valid_o(a_pixel_valid_o), .pix_o(a_pixel_o), .n_pe_o(n_pe),
+    .id_o           (ident_out), .data_o(data_out),
+    .pix_valid_o    (a_pixel_valid_o), .pix_o(a_pixel_o), .n_pe_o(n_pe),
     .pix_collision_o(coll), .cfg_mode_i(1'b0), .cfg_bit_i(1'b0), .cfg_bit_o(cfg_o),
     .obs_load_i(1'b0), .obs_shift_i(1'b0), .obs_bit_o(obs_o)
   );
@@ -35,6 +35,6 @@ module tb_de_span_video #(
   de_span_video #(.NumCols(9 * NumChips), .CarryBug(CarryBug), .Latency(Latency),
                   .NumLineBuf(8)) u_span (
     .clk_i, .rst_i, .clk_core_i, .id_i, .data_i,
-    .pix_valid_o(s_pixel_valid_o), .pix_o(s_pixel_o), .late_o, .overflow_o
+    .pix_valid_o             (s_pixel_valid_o), .pix_o(s_pixel_o), .late_o, .overflow_o
   );
 endmodule

@@ -39,7 +39,7 @@ module tb_de_varray
   );
   de_array #(.NumChips(NumChips), .CarryBug(CarryBug)) u_array (
     .clk_i(clk_a_i), .rst_i, .id_i(ident_i), .data_i,
-    .id_o(a_ident_o), .data_o(a_data_o),
+    .id_o (a_ident_o), .data_o(a_data_o),
     .pix_valid_o(a_pixel_valid_o), .pix_o(a_pixel_o),
     .n_pe_o(), .pix_collision_o(a_collision_o),
     .cfg_mode_i(1'b0), .cfg_bit_i(1'b0), .cfg_bit_o(),
