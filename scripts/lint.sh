@@ -13,7 +13,7 @@ lint_top() {  # top-module, files...
 }
 lint_top de_array $pkg rtl/xproc/de_pe.sv rtl/proto/de_skew.sv rtl/proto/de_deskew.sv \
   rtl/array/de_chip.sv rtl/array/de_array.sv
-lint_top de_data_mapper rtl/proto/de_instr_lut.sv rtl/proto/de_data_mapper.sv
+lint_top de_data_mapper $pkg rtl/proto/de_instr_lut.sv rtl/proto/de_data_mapper.sv
 array=($pkg rtl/xproc/de_pe.sv rtl/proto/de_skew.sv rtl/proto/de_deskew.sv
        rtl/array/de_chip.sv rtl/array/de_array.sv)
 for f in rtl/ctrl/*.sv; do
@@ -24,7 +24,7 @@ for f in rtl/ctrl/*.sv; do
     # call took over a minute of make test.
     lint_top "$top" -GNumChips=2 "${array[@]}" rtl/ctrl/*.sv
   else
-    lint_top "$top" $(ls rtl/ctrl/*.sv | grep -v display_controller)
+    lint_top "$top" $pkg $(ls rtl/ctrl/*.sv | grep -v display_controller)
   fi
 done
 # board top: the whole design; the other board blocks stand alone
@@ -34,7 +34,7 @@ lint_top de_board_core "${array[@]}" rtl/proto/de_instr_lut.sv rtl/proto/de_data
 for f in rtl/board/*.sv; do
   case $f in
     */de_board_core.sv) ;;
-    */de_fs_player.sv) lint_top de_fs_player rtl/proto/de_instr_lut.sv rtl/proto/de_data_mapper.sv "$f" ;;
+    */de_fs_player.sv) lint_top de_fs_player $pkg rtl/proto/de_instr_lut.sv rtl/proto/de_data_mapper.sv "$f" ;;
     *) lint_top "$(basename "$f" .sv)" "$f" ;;
   esac
 done

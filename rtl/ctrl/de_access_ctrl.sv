@@ -36,11 +36,11 @@ module de_access_ctrl #(
   input  logic [1:0]                   mode_i,
   // Instruction Buffer read sides.
   input  logic [NumBuf-1:0]            buf_valid_i,
-  input  logic [NumBuf-1:0][47:0]      buf_data_i,
+  input  logic [NumBuf-1:0][de_pkg::RecW-1:0]      buf_data_i,
   output logic [NumBuf-1:0]            buf_ready_o,
   output logic [NumBuf-1:0]            buf_drain_o,
   // Instruction bus into PE 0 (registered; one instruction every clock).
-  output logic [47:0]                  instr_o,
+  output logic [de_pkg::RecW-1:0]                  instr_o,
   output logic [NumBuf-1:0]            grant_o,        // who drives instr_o this cycle
   // Video signals aligned with the array's pixel output.
   output logic                         hsync_o,
@@ -62,7 +62,6 @@ module de_access_ctrl #(
   output logic [NumBuf-1:0]            drop_o           // a word was discarded
 );
 
-  localparam logic [11:0] IdRefresh = 12'h100;
   localparam int unsigned PipeLen   = ArrayLatency + 1;
 
   // Parameter checks at elaboration.
@@ -99,8 +98,8 @@ module de_access_ctrl #(
   logic [NumBuf-1:0][SkipW-1:0] skip_d, skip_q;
 
   for (genvar i = 0; i < NumBuf; i++) begin : g_head
-    assign head_start[i]  = (buf_data_i[i][46:45] == 2'b00);
-    assign head_marker[i] = (buf_data_i[i][47:36] == IdRefresh);
+    assign head_start[i]  = de_pkg::id_starts_cmd(de_pkg::rec_id(buf_data_i[i]));
+    assign head_marker[i] = (de_pkg::rec_id(buf_data_i[i]) == de_pkg::IdRefresh);
     assign skipping[i]    = (skip_q[i] != '0);
   end
 
@@ -195,7 +194,7 @@ module de_access_ctrl #(
 
   // ---------------------------------------------------------------------------------
   // Registered bus and events.
-  logic [47:0]       instr_d, instr_q;
+  logic [de_pkg::RecW-1:0]       instr_d, instr_q;
   logic [NumBuf-1:0] grant_q, late_q, drop_q;
   logic [11:0]       line_q, ev_line_q;
   logic              window_q, ev_refresh_q, ev_active_q, ev_last_q, ev_issue_q, ev_free_q;
@@ -203,7 +202,7 @@ module de_access_ctrl #(
   always_comb begin
     instr_d = 48'h0;  // Nop
     if (line_start) begin
-      instr_d = {IdRefresh, 36'h0};
+      instr_d = {de_pkg::IdRefresh, {de_pkg::DataW{1'b0}}};
     end else if (issue) begin
       instr_d = buf_data_i[sel];
     end
@@ -300,7 +299,7 @@ module de_access_ctrl #(
     if (rst_i) begin
       f_since_refresh <= '0;
       f_seen_refresh  <= 1'b0;
-    end else if (instr_d[47:36] == IdRefresh) begin
+    end else if (de_pkg::rec_id(instr_d) == de_pkg::IdRefresh) begin
       f_since_refresh <= '0;
       f_seen_refresh  <= 1'b1;
     end else begin
@@ -317,7 +316,7 @@ module de_access_ctrl #(
       assert ($onehot0(grant));
       if (issue) assert (buf_valid_i[sel] && buf_ready_o[sel]);
       // The Refresh is only ever issued at h = 0, and buffers never at h = 0.
-      assert ((instr_d[47:36] == IdRefresh) == line_start);
+      assert ((de_pkg::rec_id(instr_d) == de_pkg::IdRefresh) == line_start);
       if (line_start) assert (grant == '0);
       // Refresh spacing is constant: exactly one line time.
       if (f_seen_refresh) begin

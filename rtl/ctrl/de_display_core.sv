@@ -39,7 +39,7 @@ module de_display_core #(
   // y-processor write ports: [channel][y-processor].
   input  logic [NumCh-1:0][NumBuf-1:0]         wr_valid_i,
   output logic [NumCh-1:0][NumBuf-1:0]         wr_ready_o,
-  input  logic [NumCh-1:0][NumBuf-1:0][47:0]   wr_data_i,
+  input  logic [NumCh-1:0][NumBuf-1:0][de_pkg::RecW-1:0]   wr_data_i,
   // Synchronisation for the y-processors (issue time base).
   output logic [11:0]                          line_o,
   output logic                                 window_o,
@@ -49,7 +49,7 @@ module de_display_core #(
   input  logic [13:0]                          reg_addr_i,
   output logic [31:0]                          reg_rdata_o,
   // Instruction buses to the three arrays and their pixel outputs.
-  output logic [NumCh-1:0][47:0]               instr_o,
+  output logic [NumCh-1:0][de_pkg::RecW-1:0]               instr_o,
   input  logic [NumCh-1:0][11:0]               pix_i,
   input  logic [NumCh-1:0]                     pix_valid_i,
   // Video out: 12 bits per colour and an 8-bit window, sync and blank aligned.
@@ -80,7 +80,7 @@ module de_display_core #(
 
   for (genvar c = 0; c < NumCh; c++) begin : g_ch
     logic [NumBuf-1:0]       rd_valid, rd_ready, drain;
-    logic [NumBuf-1:0][47:0] rd_data;
+    logic [NumBuf-1:0][de_pkg::RecW-1:0] rd_data;
     logic                    ev_refresh, ev_active, ev_last, ev_issue, ev_free;
     logic [11:0]             ev_line;
     logic [NumBuf-1:0]       ev_late, drop;
@@ -192,8 +192,9 @@ module de_display_core #(
     info_d   = 32'h0;
     unique case (reg_addr_i[11:0])
       // ID: [31:24] 0xDC, [23:20] channels, [19:16] NumBuf, [15:0] ArrayLatency.
-      12'h000: info_d = {8'hDC, 4'(NumCh), 4'(NumBuf), 16'(ArrayLatency)};
-      12'h001: info_d = {31'h0, align_err_q};
+      de_pkg::CtrlRegId:       info_d = {de_pkg::CtrlIdMagic, 4'(NumCh), 4'(NumBuf),
+                                         16'(ArrayLatency)};
+      de_pkg::CtrlRegAlignErr: info_d = {31'h0, align_err_q};
       default: info_d = 32'h0;
     endcase
   end

@@ -29,12 +29,12 @@ module de_instr_buffer #(
   // Write side (y-processor).
   input  logic                       wr_valid_i,
   output logic                       wr_ready_o,
-  input  logic [47:0]                wr_data_i,
+  input  logic [de_pkg::RecW-1:0]                wr_data_i,
   // Read side (instruction bus, via the Access Controller).
   output logic                       rd_valid_o,
   input  logic                       rd_ready_i,
   input  logic                       drain_i,
-  output logic [47:0]                rd_data_o,
+  output logic [de_pkg::RecW-1:0]                rd_data_o,
   // Status.
   output logic                       full_o,
   output logic                       empty_o,
@@ -63,19 +63,18 @@ module de_instr_buffer #(
   // index) so that FPGA synthesis maps it to distributed RAM: as a _d/_q packed array it
   // became 768 flip-flops and a 48-bit read mux, ~3,500 LUT4 per buffer on ECP5
   // (docs/display-controller.md §9.7).
-  logic [47:0]              mem_q [Depth];
+  logic [de_pkg::RecW-1:0]              mem_q [Depth];
   logic                     mem_we;
   logic [AW-1:0]            mem_wa;
 
   logic        wr_fire, rd_fire;
-  logic [11:0] wr_id;
+  logic [de_pkg::IdW-1:0] wr_id;
   logic        wr_is_start, wr_is_marker;
   logic [AW:0] level, committed;
 
-  assign wr_id        = wr_data_i[47:36];
-  // A command starts at any slot that is neither a DATA nor an ACC slot.
-  assign wr_is_start  = (wr_id[10:9] == 2'b00);
-  assign wr_is_marker = (wr_id == 12'h100);
+  assign wr_id        = de_pkg::rec_id(wr_data_i);
+  assign wr_is_start  = de_pkg::id_starts_cmd(wr_id);
+  assign wr_is_marker = (wr_id == de_pkg::IdRefresh);
 
   assign level       = wr_ptr_q - rd_ptr_q;
   assign committed   = cm_ptr_q - rd_ptr_q;
@@ -184,7 +183,7 @@ module de_instr_buffer #(
       // No loss, duplication or reordering: reads return 0, 1, 2, ... in order.
       if (rd_valid_o) assert (rd_data_o[FW-1:0] == f_rd_cnt);
       // The tracked word k keeps its identifier.
-      if (rd_fire && f_rd_cnt == f_k) assert (f_k_seen && rd_data_o[47:36] == f_k_id);
+      if (rd_fire && f_rd_cnt == f_k) assert (f_k_seen && de_pkg::rec_id(rd_data_o) == f_k_id);
       // Inductive strengthening: the stored words are consecutive sequence numbers.
       for (int unsigned i = 0; i < Depth; i++) begin
         if (i < level) begin
@@ -192,7 +191,7 @@ module de_instr_buffer #(
         end
       end
       if (f_k_seen && f_k_off < FW'(level)) begin
-        assert (mem_q[AW'(rd_ptr_q[AW-1:0] + AW'(f_k_off))][47:36] == f_k_id);
+        assert (de_pkg::rec_id(mem_q[AW'(rd_ptr_q[AW-1:0] + AW'(f_k_off))]) == f_k_id);
       end
       // Word k cannot be in the buffer before it has been written.
       if (!f_k_seen) assert (f_k_off >= FW'(level));

@@ -211,23 +211,25 @@ module de_load_monitor #(
   always_comb begin
     rdata_d    = 32'h0;
     sel_line_d = 1'b0;
-    if (reg_addr_i[11:10] == 2'b01) begin
+    // The windows of spec/regs.toml: LINE[] (1024 entries), HIST[] (64 entries).
+    if (reg_addr_i[11:10] == de_pkg::LmLineBase[11:10]) begin
       sel_line_d = (32'(reg_addr_i[9:0]) < MaxLines);
-    end else if (reg_addr_i[11:6] == 6'h01) begin
+    end else if (reg_addr_i[11:6] == de_pkg::LmHistBase[11:6]) begin
       if (32'(reg_addr_i[5:0]) < NumBins) rdata_d = {16'h0, sn_hist_q[reg_addr_i[5:0]]};
     end else begin
       unique case (reg_addr_i)
-        12'h000: rdata_d = {8'hDE, 8'(NumBins), 4'(BinShift), 4'(NumBuf), 8'h01};
-        12'h001: rdata_d = frames_q;
-        12'h002: rdata_d = sn_issued_q;
-        12'h003: rdata_d = sn_free_q;
-        12'h004: rdata_d = {16'h0, sn_late_q};
-        12'h005: rdata_d = sn_drop_q;
-        12'h006: rdata_d = {20'h0, sn_max_q};
-        12'h007: rdata_d = {20'h0, last_line_q};
-        12'h008: rdata_d = last_rec_q;
-        12'h009: rdata_d = tot_drop_q;
-        12'h00A: rdata_d = tot_late_q;
+        de_pkg::LmRegId:        rdata_d = {de_pkg::LmIdMagic, 8'(NumBins), 4'(BinShift), 4'(NumBuf),
+                                           8'h01};
+        de_pkg::LmRegFrames:    rdata_d = frames_q;
+        de_pkg::LmRegIssued:    rdata_d = sn_issued_q;
+        de_pkg::LmRegFree:      rdata_d = sn_free_q;
+        de_pkg::LmRegLate:      rdata_d = {16'h0, sn_late_q};
+        de_pkg::LmRegDrop:      rdata_d = sn_drop_q;
+        de_pkg::LmRegMaxIssued: rdata_d = {20'h0, sn_max_q};
+        de_pkg::LmRegLastLine:  rdata_d = {20'h0, last_line_q};
+        de_pkg::LmRegLastRec:   rdata_d = last_rec_q;
+        de_pkg::LmRegTotalDrop: rdata_d = tot_drop_q;
+        de_pkg::LmRegTotalLate: rdata_d = tot_late_q;
         default: rdata_d = 32'h0;
       endcase
     end

@@ -54,7 +54,7 @@ module display_controller #(
   // y-processor write ports: [channel 0 = R, 1 = G, 2 = B][y-processor].
   input  logic [NumCh-1:0][NumBuf-1:0]         wr_valid_i,
   output logic [NumCh-1:0][NumBuf-1:0]         wr_ready_o,
-  input  logic [NumCh-1:0][NumBuf-1:0][47:0]   wr_data_i,
+  input  logic [NumCh-1:0][NumBuf-1:0][de_pkg::RecW-1:0]   wr_data_i,
   output logic [11:0]                          line_o,
   output logic                                 window_o,
   output logic [NumCh-1:0][NumBuf-1:0]         done_o,
@@ -86,7 +86,7 @@ module display_controller #(
     $fatal(1, "display_controller: NumChips must be 1..455");
   end
 
-  logic [NumCh-1:0][47:0] instr;
+  logic [NumCh-1:0][de_pkg::RecW-1:0] instr;
   logic [NumCh-1:0][11:0] pix;
   logic [NumCh-1:0]       pix_valid;
 
@@ -147,8 +147,8 @@ module display_controller #(
       .clk_i,
       .rst_i,
       .clk_core_i,
-      .id_i      (instr[c][47:36]),
-      .data_i       (instr[c][35:0]),
+      .id_i      (de_pkg::rec_id(instr[c])),
+      .data_i    (de_pkg::rec_data(instr[c])),
       .pix_valid_o(pix_valid[c]),
       .pix_o      (pix[c]),
       .late_o       (late),
@@ -172,8 +172,8 @@ module display_controller #(
     ) u_array (
       .clk_i,
       .rst_i,
-      .id_i        (instr[c][47:36]),
-      .data_i         (instr[c][35:0]),
+      .id_i        (de_pkg::rec_id(instr[c])),
+      .data_i      (de_pkg::rec_data(instr[c])),
       .id_o        (ident_out),
       .data_o         (data_out),
       .pix_valid_o  (pix_valid[c]),

@@ -27,8 +27,16 @@ VIDEO = re.compile(r"\b(?:683|1688)\b|\b16,\s*96\b|\b8,\s*24,\s*11\b|\b48,\s*112
 
 # The host register map (spec/regs.toml): register numbers, window bases, ID magics.
 REGS = re.compile(r"\b0x300[01]\b|\brd\(base \+ (?:0x[0-9a-f]+|\d+)|\b0xD[CE]\b", re.I)
+REGS_SV = re.compile(r"\b12'h0[0-9A-F]{2}:|\b8'hD[CE]\b|\[47:36\]", re.I)
 
 PLACES: list[tuple[str, tuple[re.Pattern, ...]]] = [
+    ("rtl/proto/de_instr_lut.sv", (ID_SV,)),
+    ("rtl/ctrl/de_instr_buffer.sv", (ID_SV, REGS_SV)),
+    ("rtl/ctrl/de_access_ctrl.sv", (ID_SV, REGS_SV)),
+    ("rtl/ctrl/de_video_timing.sv", (VIDEO,)),
+    ("rtl/ctrl/de_load_monitor.sv", (REGS_SV,)),
+    ("rtl/ctrl/de_display_core.sv", (REGS_SV,)),
+    ("rtl/ctrl/display_controller.sv", (REGS_SV,)),
     ("sw/hsr/src/yp_emit.c", (ID_HEX, SHIFT, VIDEO)),
     ("sim/harness/array_harness.cpp", (ID_HEX, SHIFT)),
     ("sim/dc/dc_harness.cpp", (ID_HEX, VIDEO, REGS, SHIFT)),

@@ -362,7 +362,8 @@ def _build_and_run(num_buf: int, latency: int, all_modes: bool):
     build_dir = HERE / f"sim_build_NumBuf{num_buf}_Lat{latency}"
     params = {"NumBuf": num_buf, "ArrayLatency": latency}
     runner.build(
-        sources=[ROOT / "rtl/ctrl/de_video_timing.sv", ROOT / "rtl/ctrl/de_access_ctrl.sv"],
+        sources=[ROOT / "rtl/xproc/de_pkg.sv", ROOT / "rtl/ctrl/de_video_timing.sv",
+                 ROOT / "rtl/ctrl/de_access_ctrl.sv"],
         hdl_toplevel="de_access_ctrl",
         parameters=params,
         build_dir=build_dir,

@@ -70,7 +70,7 @@ async def mapper_matches_model(dut):
 def test_de_input_circuit():
     from common.run import RTL, build_and_test
     here = Path(__file__).resolve().parent
-    srcs = [RTL / "proto" / f for f in
+    srcs = [RTL / "xproc" / "de_pkg.sv"] + [RTL / "proto" / f for f in
             ("de_instr_lut.sv", "de_data_mapper.sv", "de_skew.sv", "de_deskew.sv")]
     build_and_test(here, "de_input_circuit_tb", srcs + [here / "de_input_circuit_tb.sv"],
                    "test_de_input_circuit")

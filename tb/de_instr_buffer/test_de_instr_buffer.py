@@ -185,7 +185,7 @@ def _build_and_run(depth: int, max_cmd_len: int):
     runner = get_runner("verilator")
     build_dir = HERE / f"sim_build_Depth{depth}_MaxCmdLen{max_cmd_len}"
     runner.build(
-        sources=[ROOT / "rtl/ctrl/de_instr_buffer.sv"],
+        sources=[ROOT / "rtl/xproc/de_pkg.sv", ROOT / "rtl/ctrl/de_instr_buffer.sv"],
         hdl_toplevel="de_instr_buffer",
         parameters={"Depth": depth, "MaxCmdLen": max_cmd_len},
         build_dir=build_dir,

@@ -160,7 +160,7 @@ def _build_and_run(nb: int, bins: int, shift: int):
     build_dir = HERE / f"sim_build_NumBuf{nb}_Bins{bins}_Shift{shift}"
     params = {"NumBuf": nb, "NumBins": bins, "BinShift": shift, "MaxLines": 16}
     runner.build(
-        sources=[ROOT / "rtl/ctrl/de_load_monitor.sv"],
+        sources=[ROOT / "rtl/xproc/de_pkg.sv", ROOT / "rtl/ctrl/de_load_monitor.sv"],
         hdl_toplevel="de_load_monitor",
         parameters=params,
         build_dir=build_dir,
