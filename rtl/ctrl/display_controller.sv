@@ -147,12 +147,12 @@ module display_controller #(
       .clk_i,
       .rst_i,
       .clk_core_i,
-      .id_i      (de_pkg::rec_id(instr[c])),
-      .data_i    (de_pkg::rec_data(instr[c])),
+      .id_i       (de_pkg::rec_id(instr[c])),
+      .data_i     (de_pkg::rec_data(instr[c])),
       .pix_valid_o(pix_valid[c]),
       .pix_o      (pix[c]),
-      .late_o       (late),
-      .overflow_o   (overflow)
+      .late_o     (late),
+      .overflow_o (overflow)
     );
     assign pix_collision_o[c] = late || overflow;
     assign cfg_bit_o[c]       = cfg_bit_i[c];
@@ -161,8 +161,8 @@ module display_controller #(
     // The array's pass-through bus (for chaining virtual arrays) and its PE count are
     // not needed here.
     /* verilator lint_off UNUSEDSIGNAL */
-    logic [11:0] ident_out;
-    logic [35:0] data_out;
+    logic [de_pkg::IdW-1:0]   ident_out;
+    logic [de_pkg::DataW-1:0] data_out;
     logic [15:0] n_pe;
     /* verilator lint_on UNUSEDSIGNAL */
 
@@ -172,12 +172,12 @@ module display_controller #(
     ) u_array (
       .clk_i,
       .rst_i,
-      .id_i        (de_pkg::rec_id(instr[c])),
-      .data_i      (de_pkg::rec_data(instr[c])),
-      .id_o        (ident_out),
+      .id_i           (de_pkg::rec_id(instr[c])),
+      .data_i         (de_pkg::rec_data(instr[c])),
+      .id_o           (ident_out),
       .data_o         (data_out),
-      .pix_valid_o  (pix_valid[c]),
-      .pix_o        (pix[c]),
+      .pix_valid_o    (pix_valid[c]),
+      .pix_o          (pix[c]),
       .n_pe_o         (n_pe),
       .pix_collision_o(pix_collision_o[c]),
       .cfg_mode_i,

@@ -75,7 +75,7 @@ module de_data_mapper
   end
 
   assign valid_o = valid_q;
-  assign id_o = ident_q;
+  assign id_o    = ident_q;
   assign data_o  = data_q;
 endmodule
 
