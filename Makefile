@@ -15,7 +15,7 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
@@ -25,6 +25,7 @@ help:
 	@echo "make anim        the shipped animation through incremental frame deltas -> out/anim"
 	@echo "make demo-cmd    one command file through the golden model (DEMO_FILE=...)"
 	@echo "make test        run every test (sets itself up on first use)"
+	@echo "make gen         regenerate the ISA tables from spec/ (gen-check: diff, fail if stale)"
 	@echo "make sim         RTL regression vs golden model, HTML/JUnit reports (TIER=smoke|full|nightly J=2)"
 	@echo "make sim-merge   join the outputs of make sim SHARD=k/N (sim/out/shard-*) into one report"
 	@echo "make test-long   long random regressions (not part of make test)"
@@ -138,6 +139,10 @@ waves: $(SETUP)
 
 lint: $(SETUP)
 	$(ENV) ./scripts/lint.sh
+
+# The ISA tables of every language from spec/*.toml (de_pkg.sv, de_isa.h, isa/_tables.py).
+gen gen-check: $(SETUP)
+	$(ENV) cd sw && $(PY) -m diffengine.isa.gen $(if $(filter gen-check,$@),--check)
 
 fpga: $(SETUP)
 	$(MAKE) -C fpga all

@@ -12,6 +12,8 @@
 // keeps the whole chip. The configuration and observation chain pins are registered
 // and passed through as they are. de_chip registers its own outputs (boundary
 // registers), so the only combinational paths inside are the chip's.
+`default_nettype none
+
 module chip_top #(
   parameter int unsigned NumPe    = 9,
   parameter int unsigned CarryBug = 0
@@ -84,3 +86,5 @@ module chip_top #(
   end
   assign fold_o = fold_q;
 endmodule
+
+`default_nettype wire

@@ -6,6 +6,8 @@
 // slot and valid bit from its own slice of one serial-in shift register (so no two
 // instances see the same inputs and none can be merged or folded as constant); every
 // output bit of every instance goes into a registered XOR fold on one pin.
+`default_nettype none
+
 module span_top #(
   parameter int unsigned NumCols    = 648,
   parameter int unsigned MaxSlots   = 4,
@@ -48,11 +50,11 @@ module span_top #(
       .rst_i         (rst_q),
       .instr_valid_i (in[48]),
       .instr_ready_o (outs[c][26]),
-      .ident_i       (in[47:36]),
+      .id_i          (in[47:36]),
       .data_i        (in[35:0]),
-      .pixel_valid_o (outs[c][25]),
-      .pixel_o       (outs[c][24:13]),
-      .pixel_col_o   (outs[c][12:1]),
+      .pix_valid_o   (outs[c][25]),
+      .pix_o         (outs[c][24:13]),
+      .pix_col_o     (outs[c][12:1]),
       .busy_o        (outs[c][0])
     );
   end
@@ -65,3 +67,5 @@ module span_top #(
   end
   assign fold_o = fold_q;
 endmodule
+
+`default_nettype wire

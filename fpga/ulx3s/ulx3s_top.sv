@@ -18,6 +18,8 @@
 // The core's parameters (NumChips, FsDepth; ClkPerBit stays 217 = 115200 baud) are set
 // by the Makefile when read_slang elaborates de_board_core; this file is read by yosys'
 // own parser (it needs the ECP5 primitives' parameters), so it passes none.
+`default_nettype none
+
 module ulx3s_top (
   input  logic       clk_25mhz,
   input  logic [6:0] btn,
@@ -150,3 +152,5 @@ module ulx3s_top (
     ODDRX1F u_oddr (.SCLK(clk_shift), .RST(1'b0), .D0(d0), .D1(d1), .Q(gpdi_dp[c]));
   end
 endmodule
+
+`default_nettype wire

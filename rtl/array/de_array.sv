@@ -1,13 +1,15 @@
 // Difference Engine: the x-processor array, NumChips chips of nine PEs in a line.
 //
-//   ident_i/data_i (one instruction per clock, unskewed)
-//     -> de_skew -> chip 0 -> chip 1 -> ... -> chip NumChips-1 -> de_deskew -> ident_o/data_o
-//   pixels leave the last chip in column order, one per clock (pixel_valid_o/pixel_o).
+//   id_i/data_i (one instruction per clock, unskewed)
+//     -> de_skew -> chip 0 -> chip 1 -> ... -> chip NumChips-1 -> de_deskew -> id_o/data_o
+//   pixels leave the last chip in column order, one per clock (pix_valid_o/pix_o).
 //
 // Latency (docs/array.md): the pixel of column q of a Refresh that enters at cycle t
 // leaves at t + q + NumChips + PixLatency0, where q counts only PEs that are not
 // bypassed. Two Refreshes must be at least n_pe_o cycles apart (7.4.1: one Refresh
 // active at a time); pix_collision_o flags a violation and stays set until reset.
+`default_nettype none
+
 module de_array
   import de_pkg::*;
 #(
@@ -19,12 +21,12 @@ module de_array
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
-  input  logic [IdW-1:0]   ident_i,
+  input  logic [IdW-1:0]   id_i,
   input  logic [DataW-1:0] data_i,
-  output logic [IdW-1:0]   ident_o,
+  output logic [IdW-1:0]   id_o,
   output logic [DataW-1:0] data_o,
-  output logic             pixel_valid_o,
-  output logic [PixW-1:0]  pixel_o,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
   output logic [15:0]      n_pe_o,           // PEs built (bypassed ones included)
   output logic             pix_collision_o,
   input  logic             cfg_mode_i,
@@ -55,8 +57,8 @@ module de_array
   logic [11:0] skew_b0, skew_b1, skew_b2;
 
   de_skew u_skew (
-    .clk_i, .rst_i, .ident_i, .data_i,
-    .ident_o(skew_id), .blk0_o(skew_b0), .blk1_o(skew_b1), .blk2_o(skew_b2)
+    .clk_i, .rst_i, .id_i, .data_i,
+    .id_o(skew_id), .blk0_o(skew_b0), .blk1_o(skew_b1), .blk2_o(skew_b2)
   );
   assign id_c[0]   = skew_id;
   assign data_c[0] = {skew_b2, skew_b1, skew_b0};
@@ -87,11 +89,11 @@ module de_array
 
   de_deskew u_deskew (
     .clk_i, .rst_i,
-    .ident_i(id_c[NumChips]),
+    .id_i   (id_c[NumChips]),
     .blk0_i (data_c[NumChips][11:0]),
     .blk1_i (data_c[NumChips][23:12]),
     .blk2_i (data_c[NumChips][35:24]),
-    .ident_o, .data_o
+    .id_o, .data_o
   );
 
   logic coll_d, coll_q;
@@ -101,11 +103,13 @@ module de_array
     else       coll_q <= coll_d;
   end
 
-  assign pixel_valid_o   = pixv_c[NumChips];
-  assign pixel_o         = pix_c[NumChips];
+  assign pix_valid_o     = pixv_c[NumChips];
+  assign pix_o           = pix_c[NumChips];
   assign n_pe_o          = 16'(NumChips * NumPe);
   assign pix_collision_o = coll_q;
   assign cfg_bit_o       = cfg_c[NumChips];
   // The last chip's words come out first; within a chip, PE 0's word first.
   assign obs_bit_o       = obs_c[NumChips];
 endmodule
+
+`default_nettype wire

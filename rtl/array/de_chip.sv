@@ -12,6 +12,8 @@
 // output is masked; relative addressing makes the remaining PEs a smaller array.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
 // (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
+`default_nettype none
+
 module de_chip
   import de_pkg::*;
 #(
@@ -113,11 +115,10 @@ module de_chip_core
 );
   // Observation word per PE: {pA,pB,pC,dis,lock,acc_mode,act,id1} and the 12 control
   // pipeline bits {xz1 .. accc3}; positions follow dbg_o (structural.DBG_FIELDS).
-  localparam int unsigned ObsW     = 31;
-  localparam int unsigned DbgPixLo = 0;                        // pix, pix_valid: 13 bits
-  localparam int unsigned DbgCtlLo = DbgPixLo + PixW + 1;      // 12 control bits
-  localparam int unsigned DbgIdLo  = DbgCtlLo + 12 + DataW + IdW;  // id1 above out, id2
-  localparam int unsigned DbgObsHi = DbgIdLo + IdW + 7 - 1;    // 7 flags above id1
+  // Field positions come from de_pkg (spec/isa.toml [debug]): the control bits run
+  // from xz1 down to accc3, the flags from pA down to act, directly above id1.
+  localparam int unsigned DbgCtlW = DbgXz1Lsb - DbgAccc3Lsb + 1;
+  localparam int unsigned ObsW    = (DbgPaLsb - DbgId1Lsb + 1) + DbgCtlW;
 
   if (NumPe < 1 || NumPe > 32) begin : g_bad_num_pe
     $fatal(1, "de_chip: NumPe must be 1..32, got %0d", NumPe);
@@ -165,7 +166,7 @@ module de_chip_core
     assign pix_or[i+1]  = pix_or[i]  | ((pe_pixv && !byp_q[i]) ? pe_pix : '0);
     assign pixv_or[i+1] = pixv_or[i] | (pe_pixv && !byp_q[i]);
     assign coll[i]      = pixv_or[i] && pe_pixv && !byp_q[i];
-    assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgObsHi:DbgIdLo], pe_dbg[DbgCtlLo +: 12]};
+    assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgPaLsb:DbgId1Lsb], pe_dbg[DbgAccc3Lsb +: DbgCtlW]};
   end
 
   // Configuration shift register: enters at PE 0, leaves after PE NumPe-1.
@@ -252,3 +253,5 @@ module de_chip_bound
   assign pix_o       = pix_q;
   assign coll_o      = coll_q;
 endmodule
+
+`default_nettype wire

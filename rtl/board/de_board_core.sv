@@ -14,6 +14,8 @@
 // choice, docs/display-controller.md §9.1); each player is the single y-processor of
 // its colour. TMDS channel 0 is blue and carries {VSYNC, HSYNC} as {C1, C0} while
 // blanking, channel 1 green, channel 2 red (DVI 1.0 §3.1).
+`default_nettype none
+
 module de_board_core #(
   parameter int unsigned NumChips    = 1,      // chips of 9 PEs per colour array
   parameter int unsigned CarryBug    = 0,
@@ -223,3 +225,5 @@ module de_board_core #(
   assign vsync_o = vsync;
   assign blank_o = blank;
 endmodule
+
+`default_nettype wire

@@ -25,6 +25,8 @@
 // Flow control: a read is issued only when the FIFO has room for it and for every word
 // already in flight (credit check), so the FIFO never overflows and the player sustains
 // one word per clock.
+`default_nettype none
+
 module de_fs_player #(
   parameter int unsigned FsDepth   = 1024,   // words, a power of two
   parameter int unsigned FifoDepth = 4,      // a power of two, >= 4 for 1 word/clock
@@ -52,10 +54,10 @@ module de_fs_player #(
   output logic          pending_o         // a descriptor is waiting for the next frame
 );
   if (FsDepth < 2 || FsDepth > 65536 || (FsDepth & (FsDepth - 1)) != 0) begin : g_bad_depth
-    $error("de_fs_player: FsDepth must be a power of two, 2..65536");
+    $fatal(1, "de_fs_player: FsDepth must be a power of two, 2..65536");
   end
   if (FifoDepth < 4 || (FifoDepth & (FifoDepth - 1)) != 0) begin : g_bad_fifo
-    $error("de_fs_player: FifoDepth must be a power of two >= 4");
+    $fatal(1, "de_fs_player: FifoDepth must be a power of two >= 4");
   end
 
   localparam logic [31:0] MarkerWord = 32'h0800_0000;   // LUT code 1 = REFRESH
@@ -164,7 +166,7 @@ module de_fs_player #(
     .window_i    (s1_win_q),
     .compensate_i(s1_comp_q),
     .valid_o     (map_v),
-    .ident_o     (map_id),
+    .id_o        (map_id),
     .data_o      (map_data)
   );
 
@@ -235,3 +237,5 @@ module de_fs_player #(
   assign frame_o    = frame_q;
   assign pending_o  = pend_q;
 endmodule
+
+`default_nettype wire

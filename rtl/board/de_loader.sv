@@ -17,6 +17,8 @@
 // error stops the writes of the rest of its command. Bytes that are not a command byte
 // are counted and skipped (resynchronisation). The host waits for each reply: a reply
 // due while the previous one is still being sent is dropped and counted.
+`default_nettype none
+
 module de_loader #(
   parameter int unsigned FsDepth     = 1024,
   parameter int unsigned NumChips    = 1,
@@ -57,7 +59,7 @@ module de_loader #(
   output logic [15:0]   cmd_err_count_o
 );
   if (TimeoutBits < 4 || TimeoutBits > 30) begin : g_bad_timeout
-    $error("de_loader: TimeoutBits must be 4..30");
+    $fatal(1, "de_loader: TimeoutBits must be 4..30");
   end
 
   typedef enum logic [2:0] {SCmd, SHdr, SData, SChk, SReg} state_e;
@@ -370,3 +372,5 @@ module de_loader #(
   assign chk_err_count_o = cerr_q;
   assign cmd_err_count_o = kerr_q;
 endmodule
+
+`default_nettype wire

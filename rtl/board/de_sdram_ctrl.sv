@@ -79,14 +79,14 @@ module de_sdram_ctrl #(
   input  logic [15:0]         sd_dq_i
 );
   // ---------------------------------------------------------------- parameter checks
-  if (CasLatency != 2 && CasLatency != 3) begin : g_err_cl
-    $error("de_sdram_ctrl: CasLatency must be 2 or 3");
+  if (CasLatency != 2 && CasLatency != 3) begin : g_bad_cl
+    $fatal(1, "de_sdram_ctrl: CasLatency must be 2 or 3");
   end
-  if (RowBits < ColBits + 2 || RowBits < 11 || ColBits < 8) begin : g_err_geom
-    $error("de_sdram_ctrl: RowBits >= ColBits + 2 (A10 and the column share the pins)");
+  if (RowBits < ColBits + 2 || RowBits < 11 || ColBits < 8) begin : g_bad_geom
+    $fatal(1, "de_sdram_ctrl: RowBits >= ColBits + 2 (A10 and the column share the pins)");
   end
-  if (TckPs < 5000) begin : g_err_tck
-    $error("de_sdram_ctrl: TckPs >= 5000");
+  if (TckPs < 5000) begin : g_bad_tck
+    $fatal(1, "de_sdram_ctrl: TckPs >= 5000");
   end
 
   // ---------------------------------------------------------------- timings in clocks
@@ -104,8 +104,8 @@ module de_sdram_ctrl #(
   localparam int unsigned NBanks = 1 << BankBits;
   localparam int unsigned PipeL  = CasLatency + NBl;
 
-  if (NRefi < 64 || NRefi > 65535 || NInit > 1048575) begin : g_err_ref
-    $error("de_sdram_ctrl: tREFI / tInit out of the counters' range");
+  if (NRefi < 64 || NRefi > 65535 || NInit > 1048575) begin : g_bad_ref
+    $fatal(1, "de_sdram_ctrl: tREFI / tInit out of the counters' range");
   end
 
   // Gap checks, built for 125 MHz. A command decided now (cmd_d) is on the pins in the
@@ -120,8 +120,8 @@ module de_sdram_ctrl #(
   typedef logic [SW-1:0] since_t;
 
   if (NRc > 200 || NRfc > 200 || NRas > 200 || NRcd < 1 || NRp < 1 || NWr < 1 ||
-      NMrd < 1) begin : g_err_since
-    $error("de_sdram_ctrl: a timing is out of the 8-bit counters' range (1..200 clocks)");
+      NMrd < 1) begin : g_bad_since
+    $fatal(1, "de_sdram_ctrl: a timing is out of the 8-bit counters' range (1..200 clocks)");
   end
 
   function automatic since_t inc(since_t v);

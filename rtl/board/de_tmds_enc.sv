@@ -7,6 +7,8 @@
 // While de_i is low one of the four control tokens carries c_i = {C1, C0} (on channel 0:
 // {VSYNC, HSYNC}) and cnt restarts at 0. sym_o is registered; bit 0 is sent first.
 // The testbench model (tb/board_top/tmds.py) is the same algorithm, step by step.
+`default_nettype none
+
 module de_tmds_enc (
   input  logic       clk_i,
   input  logic       rst_i,
@@ -78,3 +80,5 @@ module de_tmds_enc (
 
   assign sym_o = sym_q;
 endmodule
+
+`default_nettype wire

@@ -5,6 +5,8 @@
 // is a framing error: the byte is not delivered, frame_err_o pulses for one clock, and
 // the receiver waits for the line to return to idle (1) before it looks for the next
 // start bit, so a break or a wrong baud rate yields errors, not garbage bytes.
+`default_nettype none
+
 module de_uart_rx #(
   parameter int unsigned ClkPerBit = 217   // 25 MHz / 115200 baud
 ) (
@@ -16,7 +18,7 @@ module de_uart_rx #(
   output logic       frame_err_o   // one clock per framing error
 );
   if (ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
-    $error("de_uart_rx: ClkPerBit must be 4..65535");
+    $fatal(1, "de_uart_rx: ClkPerBit must be 4..65535");
   end
 
   typedef enum logic [2:0] {SIdle, SStart, SData, SStop, SBreak} state_e;
@@ -108,3 +110,5 @@ module de_uart_rx #(
   assign data_o      = sh_q;
   assign frame_err_o = ferr_q;
 endmodule
+
+`default_nettype wire

@@ -1,4 +1,6 @@
 // UART transmitter of the board top (8N1, LSB first): the loader's replies.
+`default_nettype none
+
 module de_uart_tx #(
   parameter int unsigned ClkPerBit = 217
 ) (
@@ -10,7 +12,7 @@ module de_uart_tx #(
   output logic       tx_o
 );
   if (ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
-    $error("de_uart_tx: ClkPerBit must be 4..65535");
+    $fatal(1, "de_uart_tx: ClkPerBit must be 4..65535");
   end
 
   logic [9:0]  sh_d, sh_q;      // {stop, data, start}, shifted out LSB first
@@ -51,3 +53,5 @@ module de_uart_tx #(
   assign ready_o = (left_q == 4'd0);
   assign tx_o    = sh_q[0];
 endmodule
+
+`default_nettype wire

@@ -15,6 +15,8 @@
 //   up to and including the marker. Discarded words are reported on drop_o.
 // * hsync/vsync/de are delayed by 1 + ArrayLatency so that they line up with column 0
 //   of a line leaving the array ArrayLatency cycles after its Refresh is on instr_o.
+`default_nettype none
+
 module de_access_ctrl #(
   parameter int unsigned NumBuf       = 4,
   parameter int unsigned ArrayLatency = 3,
@@ -34,11 +36,11 @@ module de_access_ctrl #(
   input  logic [1:0]                   mode_i,
   // Instruction Buffer read sides.
   input  logic [NumBuf-1:0]            buf_valid_i,
-  input  logic [NumBuf-1:0][47:0]      buf_data_i,
+  input  logic [NumBuf-1:0][de_pkg::RecW-1:0]      buf_data_i,
   output logic [NumBuf-1:0]            buf_ready_o,
   output logic [NumBuf-1:0]            buf_drain_o,
   // Instruction bus into PE 0 (registered; one instruction every clock).
-  output logic [47:0]                  instr_o,
+  output logic [de_pkg::RecW-1:0]                  instr_o,
   output logic [NumBuf-1:0]            grant_o,        // who drives instr_o this cycle
   // Video signals aligned with the array's pixel output.
   output logic                         hsync_o,
@@ -60,18 +62,17 @@ module de_access_ctrl #(
   output logic [NumBuf-1:0]            drop_o           // a word was discarded
 );
 
-  localparam logic [11:0] IdRefresh = 12'h100;
   localparam int unsigned PipeLen   = ArrayLatency + 1;
 
   // Parameter checks at elaboration.
-  if (NumBuf < 1 || NumBuf > 8) begin : gen_err_numbuf
-    $error("de_access_ctrl: NumBuf must be 1..8");
+  if (NumBuf < 1 || NumBuf > 8) begin : g_bad_numbuf
+    $fatal(1, "de_access_ctrl: NumBuf must be 1..8");
   end
-  if (ArrayLatency > 4095) begin : gen_err_latency
-    $error("de_access_ctrl: ArrayLatency must be < 4096");
+  if (ArrayLatency > 4095) begin : g_bad_latency
+    $fatal(1, "de_access_ctrl: ArrayLatency must be < 4096");
   end
-  if (SkipW < 2 || SkipW > 16) begin : gen_err_skipw
-    $error("de_access_ctrl: SkipW must be 2..16");
+  if (SkipW < 2 || SkipW > 16) begin : g_bad_skipw
+    $fatal(1, "de_access_ctrl: SkipW must be 2..16");
   end
 
   // ---------------------------------------------------------------------------------
@@ -96,9 +97,9 @@ module de_access_ctrl #(
   logic [NumBuf-1:0] done_d, done_q;
   logic [NumBuf-1:0][SkipW-1:0] skip_d, skip_q;
 
-  for (genvar i = 0; i < NumBuf; i++) begin : gen_head
-    assign head_start[i]  = (buf_data_i[i][46:45] == 2'b00);
-    assign head_marker[i] = (buf_data_i[i][47:36] == IdRefresh);
+  for (genvar i = 0; i < NumBuf; i++) begin : g_head
+    assign head_start[i]  = de_pkg::id_starts_cmd(de_pkg::rec_id(buf_data_i[i]));
+    assign head_marker[i] = (de_pkg::rec_id(buf_data_i[i]) == de_pkg::IdRefresh);
     assign skipping[i]    = (skip_q[i] != '0);
   end
 
@@ -186,14 +187,14 @@ module de_access_ctrl #(
     end
   end
 
-  for (genvar i = 0; i < NumBuf; i++) begin : gen_ready
+  for (genvar i = 0; i < NumBuf; i++) begin : g_ready
     assign buf_ready_o[i] = grant[i] | mk_pop[i] | skipping[i];
     assign buf_drain_o[i] = skipping[i];
   end
 
   // ---------------------------------------------------------------------------------
   // Registered bus and events.
-  logic [47:0]       instr_d, instr_q;
+  logic [de_pkg::RecW-1:0]       instr_d, instr_q;
   logic [NumBuf-1:0] grant_q, late_q, drop_q;
   logic [11:0]       line_q, ev_line_q;
   logic              window_q, ev_refresh_q, ev_active_q, ev_last_q, ev_issue_q, ev_free_q;
@@ -201,7 +202,7 @@ module de_access_ctrl #(
   always_comb begin
     instr_d = 48'h0;  // Nop
     if (line_start) begin
-      instr_d = {IdRefresh, 36'h0};
+      instr_d = {de_pkg::IdRefresh, {de_pkg::DataW{1'b0}}};
     end else if (issue) begin
       instr_d = buf_data_i[sel];
     end
@@ -298,7 +299,7 @@ module de_access_ctrl #(
     if (rst_i) begin
       f_since_refresh <= '0;
       f_seen_refresh  <= 1'b0;
-    end else if (instr_d[47:36] == IdRefresh) begin
+    end else if (de_pkg::rec_id(instr_d) == de_pkg::IdRefresh) begin
       f_since_refresh <= '0;
       f_seen_refresh  <= 1'b1;
     end else begin
@@ -315,7 +316,7 @@ module de_access_ctrl #(
       assert ($onehot0(grant));
       if (issue) assert (buf_valid_i[sel] && buf_ready_o[sel]);
       // The Refresh is only ever issued at h = 0, and buffers never at h = 0.
-      assert ((instr_d[47:36] == IdRefresh) == line_start);
+      assert ((de_pkg::rec_id(instr_d) == de_pkg::IdRefresh) == line_start);
       if (line_start) assert (grant == '0);
       // Refresh spacing is constant: exactly one line time.
       if (f_seen_refresh) begin
@@ -334,3 +335,5 @@ module de_access_ctrl #(
 `endif
 
 endmodule
+
+`default_nettype wire

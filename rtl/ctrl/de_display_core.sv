@@ -12,6 +12,8 @@
 // * Output stage: one register for the 12-bit pixels (forced to zero while blanking), the
 //   8-bit window (pixel bits [w+7:w], optionally saturated) and hsync/vsync/blank, so
 //   everything leaves together.
+`default_nettype none
+
 module de_display_core #(
   parameter int unsigned NumBuf       = 4,    // y-processors (buffers per colour)
   parameter int unsigned BufDepth     = 16,   // words per instruction buffer
@@ -37,7 +39,7 @@ module de_display_core #(
   // y-processor write ports: [channel][y-processor].
   input  logic [NumCh-1:0][NumBuf-1:0]         wr_valid_i,
   output logic [NumCh-1:0][NumBuf-1:0]         wr_ready_o,
-  input  logic [NumCh-1:0][NumBuf-1:0][47:0]   wr_data_i,
+  input  logic [NumCh-1:0][NumBuf-1:0][de_pkg::RecW-1:0]   wr_data_i,
   // Synchronisation for the y-processors (issue time base).
   output logic [11:0]                          line_o,
   output logic                                 window_o,
@@ -47,7 +49,7 @@ module de_display_core #(
   input  logic [13:0]                          reg_addr_i,
   output logic [31:0]                          reg_rdata_o,
   // Instruction buses to the three arrays and their pixel outputs.
-  output logic [NumCh-1:0][47:0]               instr_o,
+  output logic [NumCh-1:0][de_pkg::RecW-1:0]               instr_o,
   input  logic [NumCh-1:0][11:0]               pix_i,
   input  logic [NumCh-1:0]                     pix_valid_i,
   // Video out: 12 bits per colour and an 8-bit window, sync and blank aligned.
@@ -62,11 +64,11 @@ module de_display_core #(
 );
 
   // Parameter checks at elaboration (the sub-blocks check their own ranges too).
-  if (NumBuf < 1 || NumBuf > 8) begin : gen_err_numbuf
-    $error("de_display_core: NumBuf must be 1..8");
+  if (NumBuf < 1 || NumBuf > 8) begin : g_bad_numbuf
+    $fatal(1, "de_display_core: NumBuf must be 1..8");
   end
-  if (ArrayLatency < 1 || ArrayLatency > 4095) begin : gen_err_latency
-    $error("de_display_core: ArrayLatency must be 1..4095");
+  if (ArrayLatency < 1 || ArrayLatency > 4095) begin : g_bad_latency
+    $fatal(1, "de_display_core: ArrayLatency must be 1..4095");
   end
 
   // ---------------------------------------------------------------------------------
@@ -78,7 +80,7 @@ module de_display_core #(
 
   for (genvar c = 0; c < NumCh; c++) begin : g_ch
     logic [NumBuf-1:0]       rd_valid, rd_ready, drain;
-    logic [NumBuf-1:0][47:0] rd_data;
+    logic [NumBuf-1:0][de_pkg::RecW-1:0] rd_data;
     logic                    ev_refresh, ev_active, ev_last, ev_issue, ev_free;
     logic [11:0]             ev_line;
     logic [NumBuf-1:0]       ev_late, drop;
@@ -190,8 +192,9 @@ module de_display_core #(
     info_d   = 32'h0;
     unique case (reg_addr_i[11:0])
       // ID: [31:24] 0xDC, [23:20] channels, [19:16] NumBuf, [15:0] ArrayLatency.
-      12'h000: info_d = {8'hDC, 4'(NumCh), 4'(NumBuf), 16'(ArrayLatency)};
-      12'h001: info_d = {31'h0, align_err_q};
+      de_pkg::CtrlRegId:       info_d = {de_pkg::CtrlIdMagic, 4'(NumCh), 4'(NumBuf),
+                                         16'(ArrayLatency)};
+      de_pkg::CtrlRegAlignErr: info_d = {31'h0, align_err_q};
       default: info_d = 32'h0;
     endcase
   end
@@ -273,3 +276,5 @@ module de_display_core #(
   assign align_err_o = align_err_q;
 
 endmodule
+
+`default_nettype wire

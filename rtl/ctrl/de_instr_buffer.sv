@@ -18,6 +18,8 @@
 // so Depth > MaxCmdLen guarantees that a full buffer always has a committed head.
 // drain_i (used by the Access Controller to discard a late line) also offers the
 // uncommitted tail, so even a malformed stream cannot wedge the buffer.
+`default_nettype none
+
 module de_instr_buffer #(
   parameter int unsigned Depth     = 16,
   parameter int unsigned MaxCmdLen = 10
@@ -27,12 +29,12 @@ module de_instr_buffer #(
   // Write side (y-processor).
   input  logic                       wr_valid_i,
   output logic                       wr_ready_o,
-  input  logic [47:0]                wr_data_i,
+  input  logic [de_pkg::RecW-1:0]                wr_data_i,
   // Read side (instruction bus, via the Access Controller).
   output logic                       rd_valid_o,
   input  logic                       rd_ready_i,
   input  logic                       drain_i,
-  output logic [47:0]                rd_data_o,
+  output logic [de_pkg::RecW-1:0]                rd_data_o,
   // Status.
   output logic                       full_o,
   output logic                       empty_o,
@@ -43,14 +45,14 @@ module de_instr_buffer #(
   localparam int unsigned AW = $clog2(Depth);
 
   // Parameter checks at elaboration.
-  if (Depth < 2) begin : gen_err_depth_small
-    $error("de_instr_buffer: Depth must be >= 2");
+  if (Depth < 2) begin : g_bad_depth_small
+    $fatal(1, "de_instr_buffer: Depth must be >= 2");
   end
-  if ((1 << AW) != Depth) begin : gen_err_depth_pow2
-    $error("de_instr_buffer: Depth must be a power of two");
+  if ((1 << AW) != Depth) begin : g_bad_depth_pow2
+    $fatal(1, "de_instr_buffer: Depth must be a power of two");
   end
-  if (Depth <= MaxCmdLen) begin : gen_err_depth_cmd
-    $error("de_instr_buffer: Depth must exceed MaxCmdLen (a whole command plus one)");
+  if (Depth <= MaxCmdLen) begin : g_bad_depth_cmd
+    $fatal(1, "de_instr_buffer: Depth must exceed MaxCmdLen (a whole command plus one)");
   end
 
   // Pointers carry one extra wrap bit so that full and empty are distinguishable.
@@ -61,19 +63,18 @@ module de_instr_buffer #(
   // index) so that FPGA synthesis maps it to distributed RAM: as a _d/_q packed array it
   // became 768 flip-flops and a 48-bit read mux, ~3,500 LUT4 per buffer on ECP5
   // (docs/display-controller.md §9.7).
-  logic [47:0]              mem_q [Depth];
+  logic [de_pkg::RecW-1:0]              mem_q [Depth];
   logic                     mem_we;
   logic [AW-1:0]            mem_wa;
 
   logic        wr_fire, rd_fire;
-  logic [11:0] wr_id;
+  logic [de_pkg::IdW-1:0] wr_id;
   logic        wr_is_start, wr_is_marker;
   logic [AW:0] level, committed;
 
-  assign wr_id        = wr_data_i[47:36];
-  // A command starts at any slot that is neither a DATA nor an ACC slot.
-  assign wr_is_start  = (wr_id[10:9] == 2'b00);
-  assign wr_is_marker = (wr_id == 12'h100);
+  assign wr_id        = de_pkg::rec_id(wr_data_i);
+  assign wr_is_start  = de_pkg::id_starts_cmd(wr_id);
+  assign wr_is_marker = (wr_id == de_pkg::IdRefresh);
 
   assign level       = wr_ptr_q - rd_ptr_q;
   assign committed   = cm_ptr_q - rd_ptr_q;
@@ -182,7 +183,7 @@ module de_instr_buffer #(
       // No loss, duplication or reordering: reads return 0, 1, 2, ... in order.
       if (rd_valid_o) assert (rd_data_o[FW-1:0] == f_rd_cnt);
       // The tracked word k keeps its identifier.
-      if (rd_fire && f_rd_cnt == f_k) assert (f_k_seen && rd_data_o[47:36] == f_k_id);
+      if (rd_fire && f_rd_cnt == f_k) assert (f_k_seen && de_pkg::rec_id(rd_data_o) == f_k_id);
       // Inductive strengthening: the stored words are consecutive sequence numbers.
       for (int unsigned i = 0; i < Depth; i++) begin
         if (i < level) begin
@@ -190,7 +191,7 @@ module de_instr_buffer #(
         end
       end
       if (f_k_seen && f_k_off < FW'(level)) begin
-        assert (mem_q[AW'(rd_ptr_q[AW-1:0] + AW'(f_k_off))][47:36] == f_k_id);
+        assert (de_pkg::rec_id(mem_q[AW'(rd_ptr_q[AW-1:0] + AW'(f_k_off))]) == f_k_id);
       end
       // Word k cannot be in the buffer before it has been written.
       if (!f_k_seen) assert (f_k_off >= FW'(level));
@@ -199,3 +200,5 @@ module de_instr_buffer #(
 `endif
 
 endmodule
+
+`default_nettype wire

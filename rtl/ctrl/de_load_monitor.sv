@@ -10,6 +10,8 @@
 // * cumulative discard and late-line counters.
 // The host reads 32-bit registers through a synchronous read port (data one clock after
 // the address).
+`default_nettype none
+
 module de_load_monitor #(
   parameter int unsigned NumBuf   = 4,
   parameter int unsigned NumBins  = 16,
@@ -35,17 +37,17 @@ module de_load_monitor #(
   localparam int unsigned LineAw = (MaxLines > 1) ? $clog2(MaxLines) : 1;
 
   // Parameter checks at elaboration.
-  if (NumBuf < 1 || NumBuf > 8) begin : gen_err_numbuf
-    $error("de_load_monitor: NumBuf must be 1..8");
+  if (NumBuf < 1 || NumBuf > 8) begin : g_bad_numbuf
+    $fatal(1, "de_load_monitor: NumBuf must be 1..8");
   end
-  if (NumBins < 1 || NumBins > 64) begin : gen_err_bins
-    $error("de_load_monitor: NumBins must be 1..64");
+  if (NumBins < 1 || NumBins > 64) begin : g_bad_bins
+    $fatal(1, "de_load_monitor: NumBins must be 1..64");
   end
-  if (BinShift > 11) begin : gen_err_shift
-    $error("de_load_monitor: BinShift must be 0..11");
+  if (BinShift > 11) begin : g_bad_shift
+    $fatal(1, "de_load_monitor: BinShift must be 0..11");
   end
-  if (MaxLines < 1 || MaxLines > 1024) begin : gen_err_lines
-    $error("de_load_monitor: MaxLines must be 1..1024 (register window 0x400-0x7FF)");
+  if (MaxLines < 1 || MaxLines > 1024) begin : g_bad_lines
+    $fatal(1, "de_load_monitor: MaxLines must be 1..1024 (register window 0x400-0x7FF)");
   end
 
   // Number of set bits of a buffer vector (at most 8).
@@ -209,23 +211,25 @@ module de_load_monitor #(
   always_comb begin
     rdata_d    = 32'h0;
     sel_line_d = 1'b0;
-    if (reg_addr_i[11:10] == 2'b01) begin
+    // The windows of spec/regs.toml: LINE[] (1024 entries), HIST[] (64 entries).
+    if (reg_addr_i[11:10] == de_pkg::LmLineBase[11:10]) begin
       sel_line_d = (32'(reg_addr_i[9:0]) < MaxLines);
-    end else if (reg_addr_i[11:6] == 6'h01) begin
+    end else if (reg_addr_i[11:6] == de_pkg::LmHistBase[11:6]) begin
       if (32'(reg_addr_i[5:0]) < NumBins) rdata_d = {16'h0, sn_hist_q[reg_addr_i[5:0]]};
     end else begin
       unique case (reg_addr_i)
-        12'h000: rdata_d = {8'hDE, 8'(NumBins), 4'(BinShift), 4'(NumBuf), 8'h01};
-        12'h001: rdata_d = frames_q;
-        12'h002: rdata_d = sn_issued_q;
-        12'h003: rdata_d = sn_free_q;
-        12'h004: rdata_d = {16'h0, sn_late_q};
-        12'h005: rdata_d = sn_drop_q;
-        12'h006: rdata_d = {20'h0, sn_max_q};
-        12'h007: rdata_d = {20'h0, last_line_q};
-        12'h008: rdata_d = last_rec_q;
-        12'h009: rdata_d = tot_drop_q;
-        12'h00A: rdata_d = tot_late_q;
+        de_pkg::LmRegId:        rdata_d = {de_pkg::LmIdMagic, 8'(NumBins), 4'(BinShift), 4'(NumBuf),
+                                           8'h01};
+        de_pkg::LmRegFrames:    rdata_d = frames_q;
+        de_pkg::LmRegIssued:    rdata_d = sn_issued_q;
+        de_pkg::LmRegFree:      rdata_d = sn_free_q;
+        de_pkg::LmRegLate:      rdata_d = {16'h0, sn_late_q};
+        de_pkg::LmRegDrop:      rdata_d = sn_drop_q;
+        de_pkg::LmRegMaxIssued: rdata_d = {20'h0, sn_max_q};
+        de_pkg::LmRegLastLine:  rdata_d = {20'h0, last_line_q};
+        de_pkg::LmRegLastRec:   rdata_d = last_rec_q;
+        de_pkg::LmRegTotalDrop: rdata_d = tot_drop_q;
+        de_pkg::LmRegTotalLate: rdata_d = tot_late_q;
         default: rdata_d = 32'h0;
       endcase
     end
@@ -244,3 +248,5 @@ module de_load_monitor #(
   assign reg_rdata_o = sel_line_q ? line_rd_q : rdata_q;
 
 endmodule
+
+`default_nettype wire

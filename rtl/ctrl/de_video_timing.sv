@@ -9,6 +9,8 @@
 //
 // Line layout (both axes): [0, Active) active, then front porch, sync, back porch.
 // mode_i is sampled while rst_i is high and held until the next reset.
+`default_nettype none
+
 module de_video_timing #(
   // Mode 3 ("test mode"): small totals for fast simulation and formal checks.
   parameter int unsigned TestHActive = 16,
@@ -46,54 +48,42 @@ module de_video_timing #(
 
   // Parameter checks at elaboration.
   if (TestHActive < 1 || TestHSync < 1 || TestVActive < 1 || TestVSync < 1)
-  begin : gen_err_test_zero
-    $error("de_video_timing: test mode needs non-zero active and sync widths");
+  begin : g_bad_test_zero
+    $fatal(1, "de_video_timing: test mode needs non-zero active and sync widths");
   end
   if (TestHTotal < 4 || TestHTotal > 4095 || TestVTotal < 2 || TestVTotal > 4095)
-  begin : gen_err_test_total
-    $error("de_video_timing: test mode totals must be in 4..4095 / 2..4095");
+  begin : g_bad_test_total
+    $fatal(1, "de_video_timing: test mode totals must be in 4..4095 / 2..4095");
   end
 
-  // Mode table (docs/display-controller.md §3).
+  // Mode table: spec/video.toml through de_pkg::video_mode (docs/display-controller.md
+  // §3); the test mode's geometry comes from the Test* parameters. Package names are
+  // written qualified: tb/formal reads this file with yosys's own parser, which has no
+  // `import`.
   logic [11:0] h_act, h_fp, h_sync, h_bp, v_act, v_fp, v_sync, v_bp;
   logic        h_pol, v_pol;  // 1 = active-high sync pulse
   logic [1:0]  mode_d, mode_q;
+  de_pkg::video_mode_t vm;
+  // Only its v_act is used: the reset value of v_q.
+  /* verilator lint_off UNUSEDSIGNAL */
+  de_pkg::video_mode_t vm_rst;
+  /* verilator lint_on UNUSEDSIGNAL */
 
-  always_comb begin
-    h_act  = 12'd640;  h_fp = 12'd16;  h_sync = 12'd96;  h_bp = 12'd48;
-    v_act  = 12'd480;  v_fp = 12'd10;  v_sync = 12'd2;   v_bp = 12'd33;
-    h_pol  = 1'b0;     v_pol = 1'b0;
-    unique case (mode_q)
-      2'd0: begin  // 640x480@60 (VESA DMT, 25.175 MHz, 800x525)
-      end
-      2'd1: begin  // 640x485 "low resolution" of §7.4.5 (21.5 MHz, 683x525, 59.96 Hz)
-        h_act = 12'd640;  h_fp = 12'd8;   h_sync = 12'd24;  h_bp = 12'd11;
-        v_act = 12'd485;  v_fp = 12'd11;  v_sync = 12'd2;   v_bp = 12'd27;
-      end
-      2'd2: begin  // 1280x1024@60 (VESA DMT, 108 MHz, 1688x1066)
-        h_act = 12'd1280; h_fp = 12'd48;  h_sync = 12'd112; h_bp = 12'd248;
-        v_act = 12'd1024; v_fp = 12'd1;   v_sync = 12'd3;   v_bp = 12'd38;
-        h_pol = 1'b1;     v_pol = 1'b1;
-      end
-      2'd3: begin  // test mode
-        h_act = 12'(TestHActive); h_fp = 12'(TestHFp); h_sync = 12'(TestHSync);
-        h_bp  = 12'(TestHBp);
-        v_act = 12'(TestVActive); v_fp = 12'(TestVFp); v_sync = 12'(TestVSync);
-        v_bp  = 12'(TestVBp);
-      end
-      default: ;
-    endcase
-  end
-
-  // Active lines of a mode, for the reset value (mode_q is not yet loaded then).
-  function automatic logic [11:0] vact_of(logic [1:0] m);
-    unique case (m)
-      2'd1:    vact_of = 12'd485;
-      2'd2:    vact_of = 12'd1024;
-      2'd3:    vact_of = 12'(TestVActive);
-      default: vact_of = 12'd480;
-    endcase
+  function automatic de_pkg::video_mode_t mode_of(logic [1:0] m);
+    if (m == de_pkg::VideoModeTest) begin
+      mode_of = {12'(TestHActive), 12'(TestHFp), 12'(TestHSync), 12'(TestHBp),
+                 12'(TestVActive), 12'(TestVFp), 12'(TestVSync), 12'(TestVBp), 1'b0, 1'b0};
+    end else begin
+      mode_of = de_pkg::video_mode(m);
+    end
   endfunction
+
+  assign vm = mode_of(mode_q);
+  assign {h_act, h_fp, h_sync, h_bp} = {vm.h_act, vm.h_fp, vm.h_sync, vm.h_bp};
+  assign {v_act, v_fp, v_sync, v_bp} = {vm.v_act, vm.v_fp, vm.v_sync, vm.v_bp};
+  assign {h_pol, v_pol} = {vm.h_pol, vm.v_pol};
+  // The mode being loaded, for the reset value of v_q (mode_q is not yet loaded then).
+  assign vm_rst = mode_of(mode_i);
 
   logic [11:0] h_total, v_total;
   logic [11:0] h_d, h_q, v_d, v_q;
@@ -119,7 +109,7 @@ module de_video_timing #(
       h_q    <= '0;
       // Start at the first vertical-blank line: the y-processors get a whole vertical
       // blank to fill their buffers before the window of line 0 opens.
-      v_q    <= vact_of(mode_i);
+      v_q    <= vm_rst.v_act;
     end else begin
       mode_q <= mode_d;
       h_q    <= h_d;
@@ -146,3 +136,5 @@ module de_video_timing #(
   assign next_active_o = (next_line_o < v_act);
 
 endmodule
+
+`default_nettype wire

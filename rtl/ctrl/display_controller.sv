@@ -18,6 +18,8 @@
 // with SpanLatency pixel clocks from Refresh to column 0. Its late/overflow flags come
 // out on pix_collision_o; it has no bypass or observation chain (cfg_bit_o = cfg_bit_i,
 // obs_bit_o = 0). With SpanArray = 0, clk_core_i is not used.
+`default_nettype none
+
 module display_controller #(
   parameter int unsigned NumChips    = 72,   // 648 PEs per colour (640 columns + spares)
   parameter int unsigned CarryBug    = 0,    // §7.7 fault in every PE (all three arrays)
@@ -37,8 +39,8 @@ module display_controller #(
   parameter int unsigned TestVBp     = 2,
   parameter int unsigned SpanArray   = 0,
   parameter int unsigned SpanLatency = 300,
-  // docs/array.md: a Refresh on ident_i in the cycle ending with edge E puts column q on
-  // pixel_o right after edge E + NumChips + 2 + q, i.e. NumChips + 3 cycles later.
+  // docs/array.md: a Refresh on id_i in the cycle ending with edge E puts column q on
+  // pix_o right after edge E + NumChips + 2 + q, i.e. NumChips + 3 cycles later.
   localparam int unsigned ArrayLatency = SpanArray != 0 ? SpanLatency : NumChips + 3,
   localparam int unsigned NumCh        = 3
 ) (
@@ -52,7 +54,7 @@ module display_controller #(
   // y-processor write ports: [channel 0 = R, 1 = G, 2 = B][y-processor].
   input  logic [NumCh-1:0][NumBuf-1:0]         wr_valid_i,
   output logic [NumCh-1:0][NumBuf-1:0]         wr_ready_o,
-  input  logic [NumCh-1:0][NumBuf-1:0][47:0]   wr_data_i,
+  input  logic [NumCh-1:0][NumBuf-1:0][de_pkg::RecW-1:0]   wr_data_i,
   output logic [11:0]                          line_o,
   output logic                                 window_o,
   output logic [NumCh-1:0][NumBuf-1:0]         done_o,
@@ -79,12 +81,12 @@ module display_controller #(
   output logic [NumCh-1:0]                     obs_bit_o
 );
 
-  if (NumChips < 1 || NumChips * 9 > 4095) begin : gen_err_chips
+  if (NumChips < 1 || NumChips * 9 > 4095) begin : g_bad_chips
     // HTotal >= PEs keeps Refreshes n_pe apart; the 12-bit counters cap it at 4095.
-    $error("display_controller: NumChips must be 1..455");
+    $fatal(1, "display_controller: NumChips must be 1..455");
   end
 
-  logic [NumCh-1:0][47:0] instr;
+  logic [NumCh-1:0][de_pkg::RecW-1:0] instr;
   logic [NumCh-1:0][11:0] pix;
   logic [NumCh-1:0]       pix_valid;
 
@@ -130,8 +132,8 @@ module display_controller #(
     .align_err_o
   );
 
-  if (SpanArray > 1) begin : gen_err_span
-    $error("display_controller: SpanArray must be 0 or 1");
+  if (SpanArray > 1) begin : g_bad_span
+    $fatal(1, "display_controller: SpanArray must be 0 or 1");
   end
 
   for (genvar c = 0; c < NumCh; c++) begin : g_arr
@@ -145,12 +147,12 @@ module display_controller #(
       .clk_i,
       .rst_i,
       .clk_core_i,
-      .ident_i      (instr[c][47:36]),
-      .data_i       (instr[c][35:0]),
-      .pixel_valid_o(pix_valid[c]),
-      .pixel_o      (pix[c]),
-      .late_o       (late),
-      .overflow_o   (overflow)
+      .id_i       (de_pkg::rec_id(instr[c])),
+      .data_i     (de_pkg::rec_data(instr[c])),
+      .pix_valid_o(pix_valid[c]),
+      .pix_o      (pix[c]),
+      .late_o     (late),
+      .overflow_o (overflow)
     );
     assign pix_collision_o[c] = late || overflow;
     assign cfg_bit_o[c]       = cfg_bit_i[c];
@@ -159,8 +161,8 @@ module display_controller #(
     // The array's pass-through bus (for chaining virtual arrays) and its PE count are
     // not needed here.
     /* verilator lint_off UNUSEDSIGNAL */
-    logic [11:0] ident_out;
-    logic [35:0] data_out;
+    logic [de_pkg::IdW-1:0]   ident_out;
+    logic [de_pkg::DataW-1:0] data_out;
     logic [15:0] n_pe;
     /* verilator lint_on UNUSEDSIGNAL */
 
@@ -170,12 +172,12 @@ module display_controller #(
     ) u_array (
       .clk_i,
       .rst_i,
-      .ident_i        (instr[c][47:36]),
-      .data_i         (instr[c][35:0]),
-      .ident_o        (ident_out),
+      .id_i           (de_pkg::rec_id(instr[c])),
+      .data_i         (de_pkg::rec_data(instr[c])),
+      .id_o           (ident_out),
       .data_o         (data_out),
-      .pixel_valid_o  (pix_valid[c]),
-      .pixel_o        (pix[c]),
+      .pix_valid_o    (pix_valid[c]),
+      .pix_o          (pix[c]),
       .n_pe_o         (n_pe),
       .pix_collision_o(pix_collision_o[c]),
       .cfg_mode_i,
@@ -189,3 +191,5 @@ module display_controller #(
   end
 
 endmodule
+
+`default_nettype wire

@@ -3,7 +3,11 @@
 // instruction (12-bit identifier + 36-bit 12.24 data) for a 6-bit DAC window at pixel
 // bits [w+5:w], w = 0..4, and optionally applies the carry-bug compensation.
 // One registered stage; the reference model is diffengine.binfmt.map_word.
-module de_data_mapper (
+`default_nettype none
+
+module de_data_mapper
+  import de_pkg::*;
+(
   input  logic        clk_i,
   input  logic        rst_i,
   input  logic        valid_i,
@@ -11,8 +15,8 @@ module de_data_mapper (
   input  logic [2:0]  window_i,      // w: the DAC window's lowest pixel bit, 0..4
   input  logic        compensate_i,  // apply the 7.7 carry-bug compensation
   output logic        valid_o,
-  output logic [11:0] ident_o,
-  output logic [35:0] data_o
+  output logic [IdW-1:0]   id_o,
+  output logic [DataW-1:0] data_o
 );
   logic [11:0] ident;
   logic [1:0]  op_type;
@@ -23,9 +27,9 @@ module de_data_mapper (
   logic [2:0]  w;
 
   de_instr_lut u_lut (
-    .code_i  (word_i[31:27]),
-    .ident_o (ident),
-    .type_o  (op_type)
+    .code_i(word_i[31:27]),
+    .id_o  (ident),
+    .type_o(op_type)
   );
 
   assign operand = word_i[26:0];
@@ -46,14 +50,14 @@ module de_data_mapper (
     comp = {int_wide[35:24], 1'b0, int_wide[23:1]};
 
     // An idle cycle enters the array as a Nop.
-    ident_d = valid_i ? ident : 12'h000;
+    ident_d = valid_i ? ident : IdNop;
     valid_d = valid_i;
     data_d  = 36'd0;
     if (valid_i) begin
       unique case (op_type)
-        2'd1:    data_d = {i12, 2'b00, operand[19:10], 2'b00, operand[9:0]};
-        2'd2:    data_d = compensate_i ? comp : int_wide;
-        default: data_d = 36'd0;
+        TypeAddress:   data_d = {i12, 2'b00, operand[19:10], 2'b00, operand[9:0]};
+        TypeIntensity: data_d = compensate_i ? comp : int_wide;
+        default:       data_d = '0;
       endcase
     end
   end
@@ -71,6 +75,8 @@ module de_data_mapper (
   end
 
   assign valid_o = valid_q;
-  assign ident_o = ident_q;
+  assign id_o    = ident_q;
   assign data_o  = data_q;
 endmodule
+
+`default_nettype wire

@@ -1,14 +1,16 @@
 // Output delay circuit (Kuijk 1995, 7.6.2, Fig. 7.17): realigns the skewed 36-bit bus
 // that leaves the last PE, so that a chained array or a logic analyser sees whole
 // words again. Block 0 (and the identifier) wait two cycles, block 1 one cycle.
+`default_nettype none
+
 module de_deskew (
   input  logic        clk_i,
   input  logic        rst_i,
-  input  logic [11:0] ident_i,
+  input  logic [11:0] id_i,
   input  logic [11:0] blk0_i,
   input  logic [11:0] blk1_i,
   input  logic [11:0] blk2_i,
-  output logic [11:0] ident_o,
+  output logic [11:0] id_o,
   output logic [35:0] data_o
 );
   logic [11:0] ident_q, ident_q2, blk0_q, blk0_q2, blk1_q;
@@ -21,7 +23,7 @@ module de_deskew (
       blk0_q2  <= 12'd0;
       blk1_q   <= 12'd0;
     end else begin
-      ident_q  <= ident_i;
+      ident_q  <= id_i;
       ident_q2 <= ident_q;
       blk0_q   <= blk0_i;
       blk0_q2  <= blk0_q;
@@ -29,6 +31,8 @@ module de_deskew (
     end
   end
 
-  assign ident_o = ident_q2;
+  assign id_o    = ident_q2;
   assign data_o  = {blk2_i, blk1_q, blk0_q2};
 endmodule
+
+`default_nettype wire

@@ -2,12 +2,14 @@
 // 12-bit blocks with a registered block carry, so block j of an instruction must reach
 // a PE j cycles after block 0. This circuit delays block 1 by one and block 2 by two
 // clock cycles; the identifier travels with block 0.
+`default_nettype none
+
 module de_skew (
   input  logic        clk_i,
   input  logic        rst_i,
-  input  logic [11:0] ident_i,
+  input  logic [11:0] id_i,
   input  logic [35:0] data_i,
-  output logic [11:0] ident_o,
+  output logic [11:0] id_o,
   output logic [11:0] blk0_o,
   output logic [11:0] blk1_o,
   output logic [11:0] blk2_o
@@ -26,8 +28,10 @@ module de_skew (
     end
   end
 
-  assign ident_o = ident_i;
+  assign id_o    = id_i;
   assign blk0_o  = data_i[11:0];
   assign blk1_o  = blk1_q;
   assign blk2_o  = blk2_q2;
 endmodule
+
+`default_nettype wire

@@ -6,6 +6,8 @@
 // asynchronous read is stable. Full and empty are conservative (a pointer seen late
 // only delays a write or a read). Reset: each side has its own synchronous reset; both
 // must be held together for a few clocks of the slower domain.
+`default_nettype none
+
 module de_afifo #(
   parameter int unsigned W  = 48,
   parameter int unsigned AW = 4           // 2^AW words
@@ -82,3 +84,5 @@ module de_afifo #(
     end
   end
 endmodule
+
+`default_nettype wire

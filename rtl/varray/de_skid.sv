@@ -1,6 +1,8 @@
 // Two-entry skid buffer (valid/ready on both sides): the upstream ready depends only on
 // the buffer's own count, so no combinational path runs from ready_i back to ready_o,
 // and the downstream data always comes from a register.
+`default_nettype none
+
 module de_skid #(
   parameter int unsigned W = 48
 ) (
@@ -49,3 +51,5 @@ module de_skid #(
     end
   end
 endmodule
+
+`default_nettype wire

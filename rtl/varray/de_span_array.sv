@@ -30,6 +30,8 @@
 // command, so one register captured per pass is the per-column flag of the plain array.
 // Reset: rst_i for one clock; bank 0 is then cleared through the pipeline and bank 1 by
 // the drain (NumCols clocks, busy_o high) before the first pass is issued.
+`default_nettype none
+
 module de_span_array
   import de_pkg::*;
 #(
@@ -41,11 +43,11 @@ module de_span_array
   input  logic             rst_i,
   input  logic             instr_valid_i,
   output logic             instr_ready_o,
-  input  logic [IdW-1:0]   ident_i,
+  input  logic [IdW-1:0]   id_i,
   input  logic [DataW-1:0] data_i,
-  output logic             pixel_valid_o,
-  output logic [PixW-1:0]  pixel_o,
-  output logic [11:0]      pixel_col_o,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
+  output logic [11:0]      pix_col_o,
   output logic             busy_o         // passes queued or in flight, or clearing
 );
   localparam int unsigned K    = MaxSlots;
@@ -102,47 +104,14 @@ module de_span_array
   // stage s, K+2 write back.
   tok_t tok_q [K + 3];
 
-  // The prototype's adder, with its carry fault as an option (isa.md section 7): the
-  // carry out of bit 23 enters the integer part at bit 25 instead of bit 24.
-  function automatic logic [DataW-1:0] add36(input logic [DataW-1:0] x,
-                                             input logic [DataW-1:0] y);
-    logic [24:0] lo;
-    logic [11:0] hi;
-    if (CarryBug == 0) begin
-      // One carry chain: the fault's form below puts two chains in series.
-      return x + y;
-    end
-    lo = {1'b0, x[23:0]} + {1'b0, y[23:0]};
-    hi = x[35:24] + y[35:24] + {10'd0, lo[24], 1'b0};
-    return {hi, lo[23:0]};
-  endfunction
-
-  // Register read port: code 0 (none) reads as zero ("adds 0"), as in de_pe.
-  function automatic logic [DataW-1:0] reg_of(input logic [DataW-1:0] a,
-                                              input logic [DataW-1:0] b,
-                                              input logic [DataW-1:0] c,
-                                              input logic [1:0] code);
-    case (code)
-      RegA:    return a;
-      RegB:    return b;
-      RegC:    return c;
-      default: return '0;
-    endcase
-  endfunction
-
-  function automatic logic flag_of(input logic pa, input logic pb, input logic pc,
-                                   input logic [1:0] code);
-    case (code)
-      RegA:    return pa;
-      RegB:    return pb;
-      RegC:    return pc;
-      default: return 1'b0;
-    endcase
-  endfunction
+  // The adder with its carry fault as an option (add_word) and the register reads
+  // (reg_word, reg_flag) are de_pkg functions, generated from spec/isa.toml and shared
+  // with de_pe, the C y-processor model and the Python golden model.
+  localparam bit Bug = (CarryBug == 1);
 
   // ==== front end: slots -> pass table ====================================================
   id_t id;
-  assign id = id_t'(ident_i);
+  assign id = id_t'(id_i);
 
   // Pass table. The header fields travel in the token (read once, at issue); slot j is
   // read only by stage j+1, so each slot column is its own small memory with one read
@@ -233,9 +202,9 @@ module de_span_array
         per_d   = (id.sub == SubPeriodic);
         eff_d   = (id.sub == SubEval0) ? EffEval0 : (id.sub == SubDis) ? EffDis : EffNone;
         // Periodic layout: the period in block 0, the first column in block 1 (isa.md 4).
-        x_d     = per_d ? data_i[23:12] : data_i[11:0];
-        dx_d    = per_d ? data_i[11:0] : data_i[23:12];
-        i12_d   = data_i[35:24];
+        x_d     = per_d ? word_blk(data_i, 1) : word_blk(data_i, 0);
+        dx_d    = per_d ? word_blk(data_i, 0) : word_blk(data_i, 1);
+        i12_d   = word_blk(data_i, 2);
       end else if (is_dat) begin
         // Data slots with no address slot in front act nowhere (act = 0 everywhere).
         open_d  = open_q;
@@ -243,9 +212,9 @@ module de_span_array
       end else if (id.refresh) begin
         accm_d   = 1'b0;
         wr_cnt_d = wr_cnt_q + 1'b1;
-      end else if (id.sub == SubAccModeOn) begin
+      end else if (id.sub == SubAccmodeOn) begin
         accm_d = 1'b1;
-      end else if (id.sub == SubAccModeOff) begin
+      end else if (id.sub == SubAccmodeOff) begin
         accm_d = 1'b0;
       end
     end
@@ -432,12 +401,12 @@ module de_span_array
     // The first column of a pass gets the slot's own value; inactive columns between
     // active ones pass values unchanged, so every later column gets its left neighbour's.
     assign vin  = first ? sl.val : cv_q[s];
-    assign prot = sl.prot && flag_of(st_q[s].pa, st_q[s].pb, st_q[s].pc, sl.dst);
-    assign v    = prot ? reg_of(st_q[s].a, st_q[s].b, st_q[s].c, sl.dst) : vin;
+    assign prot = sl.prot && reg_flag(sl.dst, st_q[s].pa, st_q[s].pb, st_q[s].pc);
+    assign v    = prot ? reg_word(sl.dst, st_q[s].a, st_q[s].b, st_q[s].c) : vin;
     // One adder per stage: D + A for ACC, the value plus SRC (read before DST is written)
     // for a data slot.
-    assign sum  = sl.acc ? add36(st_q[s].d, st_q[s].a)
-                         : add36(v, reg_of(st_q[s].a, st_q[s].b, st_q[s].c, sl.src));
+    assign sum  = sl.acc ? add_word(st_q[s].d, st_q[s].a, Bug)
+                         : add_word(v, reg_word(sl.src, st_q[s].a, st_q[s].b, st_q[s].c), Bug);
 
     always_comb begin
       st      = st_q[s];
@@ -661,10 +630,12 @@ module de_span_array
     end
   end
 
-  assign pixel_valid_o = pixv_q;
-  assign pixel_o       = pix_q;
-  assign pixel_col_o   = pixc_q;
+  assign pix_valid_o   = pixv_q;
+  assign pix_o         = pix_q;
+  assign pix_col_o     = pixc_q;
   assign busy_o        = scrub_q || run_q || drain_busy || (wr_cnt_q != ret_cnt_q) ||
                          (iss_cnt_q != wr_cnt_q);
 
 endmodule
+
+`default_nettype wire

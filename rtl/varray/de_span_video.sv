@@ -4,10 +4,10 @@
 // clk_i is the pixel clock and carries the instruction bus exactly as de_array sees it
 // (one slot per clock, unskewed); clk_core_i runs the span-serial array (de_span_array)
 // at a multiple of it. Pixels leave on the pixel clock with a fixed latency, as from
-// de_array: a Refresh on ident_i in the cycle ending with edge E puts column q on
-// pixel_o right after edge E + Latency - 1 + q (de_array: Latency = NumChips + 3).
+// de_array: a Refresh on id_i in the cycle ending with edge E puts column q on
+// pix_o right after edge E + Latency - 1 + q (de_array: Latency = NumChips + 3).
 //
-//   ident_i/data_i ─► de_afifo ─► de_span_array ─► line buffer ─► read out Latency after
+//   id_i/data_i ─► de_afifo ─► de_span_array ─► line buffer ─► read out Latency after
 //   (pixel clock)     (to core)   (core clock)     (NumLineBuf     each Refresh, one
 //                                                   lines)          column per pixel clock
 //
@@ -16,6 +16,8 @@
 // full, late_o / overflow_o rise and stay up until reset: the frame is then wrong, and
 // Latency or the core clock is too small for the stream. Reset: rst_i (pixel domain),
 // held for a few pixel clocks; the core side takes it through a synchroniser.
+`default_nettype none
+
 module de_span_video
   import de_pkg::*;
 #(
@@ -29,10 +31,10 @@ module de_span_video
   input  logic             clk_i,
   input  logic             rst_i,
   input  logic             clk_core_i,
-  input  logic [IdW-1:0]   ident_i,
+  input  logic [IdW-1:0]   id_i,
   input  logic [DataW-1:0] data_i,
-  output logic             pixel_valid_o,
-  output logic [PixW-1:0]  pixel_o,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
   output logic             late_o,
   output logic             overflow_o
 );
@@ -54,7 +56,7 @@ module de_span_video
 
   // ==== pixel clock: bus into the FIFO ====================================================
   logic fifo_full, ovf_d, ovf_q, is_refresh;
-  assign is_refresh = ident_i[IdRefreshBit];
+  assign is_refresh = id_i[IdRefreshBit];
 
   logic rst_c1_q, rst_c2_q;                  // rst_i synchronised to the core clock
   logic              fvalid, fready, cready;
@@ -69,7 +71,7 @@ module de_span_video
     .wclk_i  (clk_i),
     .wrst_i  (rst_i),
     .wvalid_i(!rst_i),
-    .wdata_i ({ident_i, data_i}),
+    .wdata_i ({id_i, data_i}),
     .wfull_o (fifo_full),
     .rclk_i  (clk_core_i),
     .rrst_i  (rst_c2_q),
@@ -100,11 +102,11 @@ module de_span_video
     .rst_i        (rst_c2_q),
     .instr_valid_i(cvalid),
     .instr_ready_o(cready),
-    .ident_i      (cword[IdW+DataW-1 -: IdW]),
+    .id_i         (cword[IdW+DataW-1 -: IdW]),
     .data_i       (cword[DataW-1:0]),
-    .pixel_valid_o(cpix_valid),
-    .pixel_o      (cpix),
-    .pixel_col_o  (cpix_col),
+    .pix_valid_o  (cpix_valid),
+    .pix_o        (cpix),
+    .pix_col_o    (cpix_col),
     .busy_o       (cbusy)
   );
 
@@ -225,8 +227,8 @@ module de_span_video
     end
   end
 
-  assign pixel_valid_o = pixv_q;
-  assign pixel_o       = pix_q;
+  assign pix_valid_o   = pixv_q;
+  assign pix_o         = pix_q;
   assign late_o        = late_q;
   assign overflow_o    = ovf_q;
 
@@ -234,3 +236,5 @@ module de_span_video
   logic unused;
   assign unused = cbusy;
 endmodule
+
+`default_nettype wire

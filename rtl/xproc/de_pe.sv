@@ -10,11 +10,13 @@
 // that. The 36-bit add is three 12-bit adds, one per stage, with registered block
 // carries: no carry ripples through more than 12 bits in one cycle.
 
+`default_nettype none
+
 module de_pe
   import de_pkg::*;
 #(
-  // 1 = reproduce the prototype's carry fault (isa.md section 7): the carry out of
-  // block 1 enters block 2 at bit 1 (adds 2) instead of bit 0.
+  // 1 = reproduce the prototype's carry fault (isa.md section 7, spec/isa.toml [adder]):
+  // the carry out of block 1 enters block 2 at bit 1 (adds 2) instead of bit 0.
   parameter int unsigned CarryBug = 0
 ) (
   input  logic             clk_i,
@@ -73,34 +75,9 @@ module de_pe
   assign id1 = id_t'(id_q);
   assign id2 = id_t'(id2_q);
 
-  // Register read port: code RegNone reads as zero ("adds 0").
-  function automatic logic [BlkW-1:0] sel_reg(input logic [1:0] code,
-                                              input logic [BlkW-1:0] a,
-                                              input logic [BlkW-1:0] b,
-                                              input logic [BlkW-1:0] c);
-    case (code)
-      RegA:    return a;
-      RegB:    return b;
-      RegC:    return c;
-      default: return '0;
-    endcase
-  endfunction
-
-  function automatic logic sel_flag(input logic [1:0] code, input logic a,
-                                    input logic b, input logic c);
-    case (code)
-      RegA:    return a;
-      RegB:    return b;
-      RegC:    return c;
-      default: return 1'b0;
-    endcase
-  endfunction
-
-  // Weight of the block-1 carry as it enters block 2: bit 0 normally, bit 1 with the
-  // fault (the prototype wired the carry one position too high).
-  function automatic logic [BlkW:0] carry_in2(input logic c);
-    return (BlkW + 1)'(c) << CarryBug;
-  endfunction
+  // Register reads (reg_blk, reg_flag) and the block carries (blk_carry_in, with the
+  // prototype's fault when CarryBug is 1) are de_pkg functions, shared with de_span_array.
+  localparam bit Bug = (CarryBug == 1);
 
   // ---- stage 1 address decision (needed first: it sets act for stage 0) --------------
   logic per1, fire_per1, fire_rng1, fire1, act_eff;
@@ -121,10 +98,10 @@ module de_pe
   assign rng0    = id0.addr && (id0.sub != SubPeriodic);
   assign xz0     = (in_blk[0] == '0);
   // Protection is decided once per slot, here, and travels with it down the pipeline.
-  assign prot0   = ev0 && act_eff && id0.prot && sel_flag(id0.dst, pa_q, pb_q, pc_q);
+  assign prot0   = ev0 && act_eff && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
   assign active0 = ev0 && act_eff;
-  assign v0      = prot0 ? sel_reg(id0.dst, a_q[0], b_q[0], c_q[0]) : in_blk[0];
-  assign s0      = {1'b0, v0} + {1'b0, sel_reg(id0.src, a_q[0], b_q[0], c_q[0])};
+  assign v0      = prot0 ? reg_blk(id0.dst, a_q[0], b_q[0], c_q[0]) : in_blk[0];
+  assign s0      = {1'b0, v0} + {1'b0, reg_blk(id0.src, a_q[0], b_q[0], c_q[0])};
   assign wr0     = (ev0 || st0) && act_eff && (id0.dst != RegNone);
 
   always_comb begin
@@ -145,9 +122,9 @@ module de_pe
   assign ev1     = id1.data && !id1.set;
   assign st1     = id1.data && id1.set;
   assign active1 = ev1 && act1_q;
-  assign v1      = prot1_q ? sel_reg(id1.dst, a_q[1], b_q[1], c_q[1]) : in_blk[1];
-  assign s1      = {1'b0, v1} + {1'b0, sel_reg(id1.src, a_q[1], b_q[1], c_q[1])}
-                 + (BlkW + 1)'(c1_q);
+  assign v1      = prot1_q ? reg_blk(id1.dst, a_q[1], b_q[1], c_q[1]) : in_blk[1];
+  assign s1      = {1'b0, v1} + {1'b0, reg_blk(id1.src, a_q[1], b_q[1], c_q[1])}
+                 + blk_carry_in(c1_q, 1, Bug);
   assign wr1     = (ev1 || st1) && act1_q && (id1.dst != RegNone);
   assign dis1    = id1.addr && (id1.sub == SubDis) && fire1;
   assign e0_1    = id1.addr && (id1.sub == SubEval0) && fire1;
@@ -177,9 +154,9 @@ module de_pe
   assign ev2     = id2.data && !id2.set;
   assign st2     = id2.data && id2.set;
   assign active2 = ev2 && act2_q;
-  assign v2      = prot2_q ? sel_reg(id2.dst, a_q[2], b_q[2], c_q[2]) : in_blk[2];
-  assign s2      = {1'b0, v2} + {1'b0, sel_reg(id2.src, a_q[2], b_q[2], c_q[2])}
-                 + carry_in2(c2_q);
+  assign v2      = prot2_q ? reg_blk(id2.dst, a_q[2], b_q[2], c_q[2]) : in_blk[2];
+  assign s2      = {1'b0, v2} + {1'b0, reg_blk(id2.src, a_q[2], b_q[2], c_q[2])}
+                 + blk_carry_in(c2_q, 2, Bug);
   assign wr2     = (ev2 || st2) && act2_q && (id2.dst != RegNone);
   assign out2    = active2 ? s2[BlkW-1:0] : in_blk[2];
 
@@ -204,8 +181,8 @@ module de_pe
   assign acc_act1 = id1.acc && act1_q;
   assign accen1   = acc_act1 && !lock_q && !dis_q && !(accm_q && a2_sign_next);
   assign sa0 = {1'b0, d_q[0]} + {1'b0, a_q[0]};
-  assign sa1 = {1'b0, d_q[1]} + {1'b0, a_q[1]} + (BlkW + 1)'(accc2_q);
-  assign sa2 = {1'b0, d_q[2]} + {1'b0, a_q[2]} + carry_in2(accc3_q);
+  assign sa1 = {1'b0, d_q[1]} + {1'b0, a_q[1]} + blk_carry_in(accc2_q, 1, Bug);
+  assign sa2 = {1'b0, d_q[2]} + {1'b0, a_q[2]} + blk_carry_in(accc3_q, 2, Bug);
 
   // D's next value before a Refresh clear. Eval0 wins over an ACC write of the same
   // cycle: an ACC can only coincide with an Eval0 that follows it in the stream.
@@ -309,10 +286,10 @@ module de_pe
         default: ;
       endcase
     end
-    if (no_class0 && (id0.sub == SubAccModeOn)) begin
+    if (no_class0 && (id0.sub == SubAccmodeOn)) begin
       accm_d = 1'b1;
     end
-    if (no_class0 && (id0.sub == SubAccModeOff)) begin
+    if (no_class0 && (id0.sub == SubAccmodeOff)) begin
       accm_d = 1'b0;
     end
     if (id0.refresh) begin
@@ -431,3 +408,5 @@ module de_pe
                   pixv_q, pix_q};
 
 endmodule
+
+`default_nettype wire

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "Vdisplay_controller.h"
+#include "de_isa.h"
 #include "verilated.h"
 #include <ctime>
 #include <unistd.h>
@@ -48,7 +49,7 @@
 namespace {
 
 constexpr int kCh = 3;
-constexpr uint16_t kRefresh = 0x100;
+constexpr uint16_t kRefresh = DE_ID_REFRESH;
 
 struct Geom {
   int ha, hfp, hs, hbp, va, vfp, vs, vbp;
@@ -57,17 +58,16 @@ struct Geom {
   int vtotal() const { return va + vfp + vs + vbp; }
 };
 
-// docs/display-controller.md §3.
+// docs/display-controller.md §3; the fixed modes come from de_isa.h (spec/video.toml).
 Geom mode_geom(int mode) {
-  switch (mode) {
-    case 1: return {640, 8, 24, 11, 485, 11, 2, 27, false, false};
-    case 2: return {1280, 48, 112, 248, 1024, 1, 3, 38, true, true};
-    case 3: {
-      const int t[8] = {DC_TEST_GEOM};  // the Test* parameters of this build
-      return {t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], false, false};
-    }
-    default: return {640, 16, 96, 48, 480, 10, 2, 33, false, false};
+  if (mode == DE_VIDEO_MODE_TEST) {
+    const int t[8] = {DC_TEST_GEOM};  // the Test* parameters of this build
+    return {t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], false, false};
   }
+  const de_video_mode* m = de_video_mode_get(mode);
+  if (!m) m = de_video_mode_get(0);
+  return {m->h[0], m->h[1], m->h[2], m->h[3], m->v[0], m->v[1], m->v[2], m->v[3],
+          m->hpol != 0, m->vpol != 0};
 }
 
 bool read_de48(const char* path, std::vector<uint64_t>& out, std::string& err) {
@@ -106,7 +106,7 @@ std::vector<std::pair<size_t, size_t>> split_lines(const std::vector<uint64_t>& 
   std::vector<std::pair<size_t, size_t>> lines;
   size_t start = 0;
   for (size_t i = 0; i < w.size(); ++i)
-    if ((w[i] >> 36) == kRefresh) {
+    if ((w[i] >> DE_WORD_BITS) == kRefresh) {
       lines.emplace_back(start, i + 1);
       start = i + 1;
     }
@@ -219,7 +219,7 @@ int main(int argc, char** argv) {
   top->rst_i = 1;
   top->mode_i = mode;
   top->wr_valid_i = 0;
-  top->reg_addr_i = 0x3000;
+  top->reg_addr_i = (DE_REG_INFO_CHAN << DE_REG_CHAN_LSB) | DE_CTRL_REG_ID;
   top->out8_shift_i = 4;
   top->out8_sat_i = 0;
   top->cfg_mode_i = 0;
@@ -231,8 +231,9 @@ int main(int argc, char** argv) {
   tick();  // the controller's registers read one clock after the address (blank lines)
   tick();
   const uint32_t ctl_id = top->reg_rdata_o;
-  if ((ctl_id >> 24) != 0xDC) {
-    std::fprintf(stderr, "%s: controller ID register reads 0x%08x (want 0xDC......)\n", argv[0], ctl_id);
+  if ((ctl_id >> 24) != DE_CTRL_ID_MAGIC) {
+    std::fprintf(stderr, "%s: controller ID register reads 0x%08x (want 0x%02X......)\n", argv[0], ctl_id,
+                 DE_CTRL_ID_MAGIC);
     return 2;
   }
   const int num_buf = (ctl_id >> 16) & 0xF;
@@ -254,7 +255,7 @@ int main(int argc, char** argv) {
   };
   auto line_word = [&](int c, int b, size_t n, size_t k) -> uint64_t {
     size_t len = line_len(c, b, n);
-    if (k + 1 == len) return static_cast<uint64_t>(kRefresh) << 36 | (n % g.va);  // marker
+    if (k + 1 == len) return static_cast<uint64_t>(kRefresh) << DE_WORD_BITS | (n % g.va);  // marker
     return words[c][lines[c][n].first + k];
   };
   const int wide_words = (kCh * num_buf * 48 + 31) / 32;
@@ -281,7 +282,7 @@ int main(int argc, char** argv) {
         Port& p = port[c * num_buf + b];
         if (p.line < total_lines) {
           valid |= 1u << (c * num_buf + b);
-          set_word(wr_data, (c * num_buf + b) * 48, line_word(c, b, p.line, p.pos));
+          set_word(wr_data, (c * num_buf + b) * DE_RECORD_BITS, line_word(c, b, p.line, p.pos));
         }
       }
     top->wr_valid_i = valid;
@@ -414,19 +415,24 @@ int main(int argc, char** argv) {
     for (int b = 0; b < num_buf; ++b) s += port[c * num_buf + b].written;
     j += std::to_string(s) + (c + 1 < kCh ? ", " : "],\n");
   }
-  j += "  \"controller\": {\"id\": " + std::to_string(rd(0x3000)) +
-       ", \"align_err\": " + std::to_string(rd(0x3001) & 1) + "},\n  \"load_monitor\": {\n";
+  // The register map is spec/regs.toml's (de_isa.h).
+  const uint32_t info = DE_REG_INFO_CHAN << DE_REG_CHAN_LSB;
+  j += "  \"controller\": {\"id\": " + std::to_string(rd(info | DE_CTRL_REG_ID)) +
+       ", \"align_err\": " + std::to_string(rd(info | DE_CTRL_REG_ALIGN_ERR) & 1) +
+       "},\n  \"load_monitor\": {\n";
   const char* names[kCh] = {"R", "G", "B"};
   uint64_t late_total = 0, dropped_total = 0;
   for (int c = 0; c < kCh; ++c) {
-    const uint32_t base = static_cast<uint32_t>(c) << 12;
-    const uint32_t id = rd(base + 0x000);
-    if ((id >> 24) != 0xDE) errors.push_back(std::string("load monitor ") + names[c] +
+    const uint32_t base = static_cast<uint32_t>(c) << DE_REG_CHAN_LSB;
+    const uint32_t id = rd(base + DE_LM_REG_ID);
+    if ((id >> 24) != DE_LM_ID_MAGIC) errors.push_back(std::string("load monitor ") + names[c] +
                                              ": bad ID register");
     const int bins = (id >> 16) & 0xFF, shift = (id >> 12) & 0xF;
-    const uint32_t fc = rd(base + 1), iss = rd(base + 2), fre = rd(base + 3), late = rd(base + 4),
-                   drop = rd(base + 5), mx = rd(base + 6), last = rd(base + 7),
-                   tdrop = rd(base + 9), tlate = rd(base + 10);
+    const uint32_t fc = rd(base + DE_LM_REG_FRAMES), iss = rd(base + DE_LM_REG_ISSUED),
+                   fre = rd(base + DE_LM_REG_FREE), late = rd(base + DE_LM_REG_LATE),
+                   drop = rd(base + DE_LM_REG_DROP), mx = rd(base + DE_LM_REG_MAX_ISSUED),
+                   last = rd(base + DE_LM_REG_LAST_LINE), tdrop = rd(base + DE_LM_REG_TOTAL_DROP),
+                   tlate = rd(base + DE_LM_REG_TOTAL_LATE);
     late_total += tlate;
     dropped_total += tdrop;
     std::snprintf(tmp, sizeof tmp,
@@ -435,11 +441,11 @@ int main(int argc, char** argv) {
                   "\"total_late_lines\": %u, \"bin_width\": %d, \"hist\": [",
                   names[c], fc, iss, fre, late, drop, mx, last, tdrop, tlate, 1 << shift);
     j += tmp;
-    for (int b = 0; b < bins; ++b) j += std::to_string(rd(base + 0x40 + b)) + (b + 1 < bins ? ", " : "");
+    for (int b = 0; b < bins; ++b) j += std::to_string(rd(base + DE_LM_HIST_BASE + b)) + (b + 1 < bins ? ", " : "");
     j += "],\n      \"line_issued\": [";
     const int nl = std::min(g.va, 1024);
     std::vector<uint32_t> rec(nl);
-    for (int l = 0; l < nl; ++l) rec[l] = rd(base + 0x400 + l);
+    for (int l = 0; l < nl; ++l) rec[l] = rd(base + DE_LM_LINE_BASE + l);
     for (int l = 0; l < nl; ++l) j += std::to_string(rec[l] & 0xFFF) + (l + 1 < nl ? ", " : "");
     j += "],\n      \"late_line_numbers\": [";
     bool first = true;

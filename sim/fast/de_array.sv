@@ -16,12 +16,12 @@ module de_array
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
-  input  logic [IdW-1:0]   ident_i,
+  input  logic [IdW-1:0]   id_i,
   input  logic [DataW-1:0] data_i,
-  output logic [IdW-1:0]   ident_o,
+  output logic [IdW-1:0]   id_o,
   output logic [DataW-1:0] data_o,
-  output logic             pixel_valid_o,
-  output logic [PixW-1:0]  pixel_o,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
   output logic [15:0]      n_pe_o,
   output logic             pix_collision_o,
   input  logic             cfg_mode_i,
@@ -36,7 +36,7 @@ module de_array
   import "DPI-C" function void de_fast_step(
     input chandle h, input bit rst, input int ident, input longint data,
     input bit cfg_mode, input bit cfg_bit, input bit obs_load, input bit obs_shift,
-    output int ident_o, output longint data_o, output bit pixv_o, output int pix_o,
+    output int id_o, output longint data_o, output bit pixv_o, output int pix_o,
     output bit coll_o, output bit cfg_bit_o, output bit obs_bit_o);
 
   if (FaultMask != '0) begin : g_bad_fault_mask
@@ -58,7 +58,7 @@ module de_array
   logic [PixW-1:0]  pix_q;
 
   always @(posedge clk_i) begin
-    de_fast_step(h, rst_i, 32'(ident_i), 64'(data_i), cfg_mode_i, cfg_bit_i, obs_load_i,
+    de_fast_step(h, rst_i, 32'(id_i), 64'(data_i), cfg_mode_i, cfg_bit_i, obs_load_i,
                  obs_shift_i, s_id, s_data, s_pixv, s_pix, s_coll, s_cfg, s_obs);
     id_q   <= IdW'(s_id);
     data_q <= DataW'(s_data);
@@ -69,10 +69,10 @@ module de_array
     obs_q  <= s_obs;
   end
 
-  assign ident_o         = id_q;
+  assign id_o            = id_q;
   assign data_o          = data_q;
-  assign pixel_valid_o   = pixv_q;
-  assign pixel_o         = pix_q;
+  assign pix_valid_o     = pixv_q;
+  assign pix_o           = pix_q;
   assign n_pe_o          = 16'(NumChips * NumPe);
   assign pix_collision_o = coll_q;
   assign cfg_bit_o       = cfg_q;

@@ -111,10 +111,10 @@ inline void take_bus(Dst& d, const Src& s) {
 }  // namespace
 
 Out Array::step(const In& in) {
-  // 1. The head's core is combinational from ident_i/data_i: settle it for this cycle.
+  // 1. The head's core is combinational from id_i/data_i: settle it for this cycle.
   Vde_fast_head& h = *head_;
   h.rst_i = in.rst;
-  h.ident_i = in.ident;
+  h.id_i = in.ident;
   h.data_i = in.data;
   h.cfg_mode_i = in.cfg_mode;
   h.cfg_bit_i = in.cfg_bit;
@@ -156,10 +156,10 @@ Out Array::step(const In& in) {
   edge(h);
 
   Out o;
-  o.ident = t.ident_o;
+  o.ident = t.id_o;
   o.data = t.data_o;
-  o.pixel_valid = t.pixel_valid_o;
-  o.pixel = t.pixel_o;
+  o.pixel_valid = t.pix_valid_o;
+  o.pixel = t.pix_o;
   o.collision = t.pix_collision_o;
   if (units_.empty()) {
     o.cfg_bit = h.cfg_bit_o;
@@ -184,7 +184,7 @@ extern "C" void* de_fast_new(int num_chips, int num_pe, int carry_bug, const cha
 }
 
 extern "C" void de_fast_step(void* hp, svBit rst, int ident, long long data, svBit cfg_mode,
-                             svBit cfg_bit, svBit obs_load, svBit obs_shift, int* ident_o,
+                             svBit cfg_bit, svBit obs_load, svBit obs_shift, int* id_o,
                              long long* data_o, svBit* pixv_o, int* pix_o, svBit* coll_o,
                              svBit* cfg_bit_o, svBit* obs_bit_o) {
   auto* a = static_cast<de_fast::Array*>(hp);
@@ -197,7 +197,7 @@ extern "C" void de_fast_step(void* hp, svBit rst, int ident, long long data, svB
   in.obs_load = obs_load;
   in.obs_shift = obs_shift;
   const de_fast::Out o = a->step(in);
-  *ident_o = o.ident;
+  *id_o = o.ident;
   *data_o = static_cast<long long>(o.data);
   *pixv_o = o.pixel_valid;
   *pix_o = o.pixel;

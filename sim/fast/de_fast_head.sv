@@ -10,7 +10,7 @@ module de_fast_head
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
-  input  logic [IdW-1:0]   ident_i,
+  input  logic [IdW-1:0]   id_i,
   input  logic [DataW-1:0] data_i,
   output logic [IdW-1:0]   id_o,
   output logic [DataW-1:0] data_o,
@@ -30,8 +30,8 @@ module de_fast_head
   /* verilator lint_on UNUSEDSIGNAL */
 
   de_skew u_skew (
-    .clk_i, .rst_i, .ident_i, .data_i,
-    .ident_o(skew_id), .blk0_o(skew_b0), .blk1_o(skew_b1), .blk2_o(skew_b2)
+    .clk_i, .rst_i, .id_i, .data_i,
+    .id_o(skew_id), .blk0_o(skew_b0), .blk1_o(skew_b1), .blk2_o(skew_b2)
   );
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug)) u_core (

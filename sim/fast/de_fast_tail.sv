@@ -13,10 +13,10 @@ module de_fast_tail
   input  logic [PixW-1:0]  pix_i,
   input  logic             coll_i,
   input  logic             coll_others_i, // OR of chips 0..NumChips-2's collision_o
-  output logic [IdW-1:0]   ident_o,
+  output logic [IdW-1:0]   id_o,
   output logic [DataW-1:0] data_o,
-  output logic             pixel_valid_o,
-  output logic [PixW-1:0]  pixel_o,
+  output logic             pix_valid_o,
+  output logic [PixW-1:0]  pix_o,
   output logic             pix_collision_o
 );
   logic [IdW-1:0]   b_id;
@@ -25,16 +25,16 @@ module de_fast_tail
 
   de_chip_bound u_bound (
     .clk_i, .rst_i, .id_i, .data_i, .pix_valid_i, .pix_i, .coll_i,
-    .id_o(b_id), .data_o(b_data), .pix_valid_o(pixel_valid_o), .pix_o(pixel_o), .coll_o(b_coll)
+    .id_o(b_id), .data_o(b_data), .pix_valid_o(pix_valid_o), .pix_o(pix_o), .coll_o(b_coll)
   );
 
   de_deskew u_deskew (
     .clk_i, .rst_i,
-    .ident_i(b_id),
+    .id_i   (b_id),
     .blk0_i (b_data[11:0]),
     .blk1_i (b_data[23:12]),
     .blk2_i (b_data[35:24]),
-    .ident_o, .data_o
+    .id_o, .data_o
   );
 
   // The same sticky flag as de_array's coll_q.

@@ -15,13 +15,8 @@
 
 #include "Vflat.h"
 #include "de_fast.h"
+#include "de_isa.h"
 #include "verilated.h"
-
-namespace {
-// The identifiers of the instruction look-up table (docs/isa.md), plus raw random ones.
-const uint16_t kOps[] = {0x000, 0x100, 0x001, 0x002, 0x800, 0x801, 0x802, 0x803, 0x200, 0x444,
-                         0x484, 0x4c4, 0x4b4, 0x464, 0x460, 0x450, 0x448, 0x488, 0x4c8};
-}  // namespace
 
 int main(int argc, char** argv) {
   long long cycles = 200000;
@@ -63,9 +58,11 @@ int main(int argc, char** argv) {
     de_fast::In in;
     in.rst = c < 3 || (c % 50000 == 25000 && pct(50));
     if (pct(90)) {
-      in.ident = pct(refresh_pct) ? 0x100 : kOps[rng() % (sizeof kOps / sizeof kOps[0])];
+      // The identifiers of the instruction look-up table, plus raw random ones below.
+      in.ident = static_cast<uint16_t>(pct(refresh_pct) ? DE_ID_REFRESH
+                                                        : de_lut_ident(rng() % DE_LUT_ENTRIES));
     } else {
-      in.ident = static_cast<uint16_t>(rng() & 0xfff);
+      in.ident = static_cast<uint16_t>(rng() & DE_ID_MASK);
     }
     const int kind = static_cast<int>(rng() % 4);
     in.data = kind == 0 ? (rng() & 0xfffffffffULL)
@@ -82,7 +79,7 @@ int main(int argc, char** argv) {
 
     Vflat& f = *flat;
     f.rst_i = in.rst;
-    f.ident_i = in.ident;
+    f.id_i = in.ident;
     f.data_i = in.data;
     f.cfg_mode_i = in.cfg_mode;
     f.cfg_bit_i = in.cfg_bit;
@@ -94,9 +91,9 @@ int main(int argc, char** argv) {
     f.eval();
     const de_fast::Out o = fast.step(in);
     stats_pix += o.pixel_valid;
-    const bool same = o.ident == f.ident_o && o.data == f.data_o &&
-                      o.pixel_valid == static_cast<bool>(f.pixel_valid_o) &&
-                      o.pixel == f.pixel_o && o.collision == static_cast<bool>(f.pix_collision_o) &&
+    const bool same = o.ident == f.id_o && o.data == f.data_o &&
+                      o.pixel_valid == static_cast<bool>(f.pix_valid_o) &&
+                      o.pixel == f.pix_o && o.collision == static_cast<bool>(f.pix_collision_o) &&
                       o.cfg_bit == static_cast<bool>(f.cfg_bit_o) &&
                       o.obs_bit == static_cast<bool>(f.obs_bit_o);
     if (!same) {
@@ -104,8 +101,8 @@ int main(int argc, char** argv) {
           "equiv: DIFFERENT at cycle %lld (seed %llu)\n"
           "  flat: ident %03x data %09llx pixv %d pixel %03x coll %d cfg_bit %d obs_bit %d\n"
           "  fast: ident %03x data %09llx pixv %d pixel %03x coll %d cfg_bit %d obs_bit %d\n",
-          c, static_cast<unsigned long long>(seed), f.ident_o,
-          static_cast<unsigned long long>(f.data_o), f.pixel_valid_o, f.pixel_o,
+          c, static_cast<unsigned long long>(seed), f.id_o,
+          static_cast<unsigned long long>(f.data_o), f.pix_valid_o, f.pix_o,
           f.pix_collision_o, f.cfg_bit_o, f.obs_bit_o, o.ident,
           static_cast<unsigned long long>(o.data), o.pixel_valid, o.pixel, o.collision,
           o.cfg_bit, o.obs_bit);

@@ -26,6 +26,8 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include "de_isa.h"
 #include <vector>
 
 #include "Vde_array.h"
@@ -44,29 +46,13 @@
 namespace {
 
 constexpr int kExitBreak = 3;   // a breakpoint stopped the run
-constexpr uint16_t kRefresh = 0x100;
+constexpr uint16_t kRefresh = DE_ID_REFRESH;
 constexpr int kPixLatency = 3;  // docs/array.md: exit(q) = R + NumChips + 3 + q
 constexpr int kPePerChip = 9;
 
 struct Instr {
   uint16_t ident;
   uint64_t data;
-};
-
-// The 19 identifiers of the instruction look-up table, as sw/diffengine/isa.py LUT
-// names them (--list-ops prints this table; a test compares it with isa.LUT).
-struct OpName {
-  const char* name;
-  uint16_t ident;
-};
-const OpName kOps[] = {
-    {"NOP", 0x000},        {"REFRESH", 0x100},       {"ACCMODE_ON", 0x001},
-    {"ACCMODE_OFF", 0x002}, {"ADDR_RANGE", 0x800},    {"ADDR_PERIODIC", 0x801},
-    {"ADDR_EVAL0", 0x802}, {"ADDR_DIS", 0x803},      {"ACC", 0x200},
-    {"D_A", 0x444},        {"D_B", 0x484},           {"D_C", 0x4c4},
-    {"D_B_C", 0x4b4},      {"D_A_B", 0x464},         {"D_A_B_NP", 0x460},
-    {"D_A_A_NP", 0x450},   {"SET_A", 0x448},         {"SET_B", 0x488},
-    {"SET_C", 0x4c8},
 };
 
 bool read_de48(const std::string& path, std::vector<Instr>& out, std::string& err) {
@@ -81,12 +67,12 @@ bool read_de48(const std::string& path, std::vector<Instr>& out, std::string& er
     std::fclose(f);
     return false;
   }
-  unsigned char w[6];
+  unsigned char w[DE_RECORD_BITS / 8];
   size_t n;
-  while ((n = std::fread(w, 1, 6, f)) == 6) {
+  while ((n = std::fread(w, 1, sizeof w, f)) == sizeof w) {
     uint64_t v = 0;
-    for (int i = 0; i < 6; ++i) v = (v << 8) | w[i];
-    out.push_back({static_cast<uint16_t>(v >> 36), v & ((1ULL << 36) - 1)});
+    for (unsigned char b : w) v = (v << 8) | b;
+    out.push_back({static_cast<uint16_t>(v >> DE_WORD_BITS), v & DE_WORD_MASK});
   }
   std::fclose(f);
   if (n != 0) {
@@ -198,13 +184,14 @@ bool parse_pe_list(const std::string& spec, int n_pe, std::vector<int>& out,
 }
 
 bool parse_op(const char* s, int& ident) {
-  for (const OpName& o : kOps)
-    if (!strcasecmp(s, o.name)) {
-      ident = o.ident;
+  // The identifiers by their look-up table names (de_isa.h, from spec/isa.toml).
+  for (unsigned c = 0; c < DE_LUT_ENTRIES; ++c)
+    if (!strcasecmp(s, de_lut_name(c))) {
+      ident = static_cast<int>(de_lut_ident(c));
       return true;
     }
   long long v;
-  if (parse_num(s, v) && v >= 0 && v < 4096) {
+  if (parse_num(s, v) && v >= 0 && v <= DE_ID_MASK) {
     ident = static_cast<int>(v);
     return true;
   }
@@ -328,7 +315,8 @@ std::string state_row(uint64_t cycle, const PeProbe& pr, const Instr& in0, long 
   uint64_t id, data;
   if (pr.pe == 0) {
     id = in0.ident;
-    data = (in0.data & 0xFFF) | (pr.skew1.get() << 12) | (pr.skew2.get() << 24);
+    data = (in0.data & DE_BLOCK_MASK) | (pr.skew1.get() << DE_BLOCK_BITS) |
+           (pr.skew2.get() << (2 * DE_BLOCK_BITS));
   } else {
     id = pr.in_id.get();
     data = pr.in_data.get();
@@ -378,8 +366,8 @@ bool write_gtkw(const std::string& fst, const std::vector<int>& pes, uint64_t t0
   std::string abs = fst;
   if (fst[0] != '/' && getcwd(cwd, sizeof cwd)) abs = std::string(cwd) + "/" + fst;
   std::fprintf(f, "[dumpfile] \"%s\"\n[timestart] %llu\n[size] 1800 1000\n"
-               "[sst_expanded] 0\n@28\nTOP.clk_i\n@22\nTOP.ident_i[11:0]\nTOP.data_i[35:0]\n"
-               "@28\nTOP.pixel_valid_o\n@22\nTOP.pixel_o[11:0]\n",
+               "[sst_expanded] 0\n@28\nTOP.clk_i\n@22\nTOP.id_i[11:0]\nTOP.data_i[35:0]\n"
+               "@28\nTOP.pix_valid_o\n@22\nTOP.pix_o[11:0]\n",
                abs.c_str(), static_cast<unsigned long long>(t0));
   for (int p : pes) {
     const std::string s = "TOP." + pe_scope(p) + ".";
@@ -563,7 +551,8 @@ int main(int argc, char** argv) {
     }
   }
   if (o.list_ops) {
-    for (const OpName& op : kOps) std::printf("%s 0x%03x\n", op.name, op.ident);
+    for (unsigned c = 0; c < DE_LUT_ENTRIES; ++c)
+      std::printf("%s 0x%03x\n", de_lut_name(c), de_lut_ident(c));
     return 0;
   }
   if (o.repeat < 1) o.repeat = 1;
@@ -633,8 +622,8 @@ int main(int argc, char** argv) {
                             static_cast<uint64_t>(slot)) - refresh_at.begin();
   };
 
-  // The window: --line L = from the cycle Refresh L-1 is on ident_i (cycle 0 for L = 0)
-  // to the cycle line L's last pixel is on pixel_o.
+  // The window: --line L = from the cycle Refresh L-1 is on id_i (cycle 0 for L = 0)
+  // to the cycle line L's last pixel is on pix_o.
   uint64_t w_from = 0, w_to = total ? total - 1 : 0;
   if (o.line >= 0) {
     if (static_cast<uint64_t>(o.line) >= refresh_at.size()) {
@@ -662,7 +651,7 @@ int main(int argc, char** argv) {
                    o.break_line, static_cast<long long>(refresh_at.size()) - 1);
       return 2;
     }
-    // Line L starts when its first instruction is on ident_i.
+    // Line L starts when its first instruction is on id_i.
     const uint64_t c = o.break_line ? refresh_at[o.break_line - 1] + 1 : 0;
     break_at = std::min(break_at, c);
   }
@@ -732,7 +721,7 @@ int main(int argc, char** argv) {
     top->eval();
   };
   top->rst_i = 1;
-  top->ident_i = 0;
+  top->id_i = 0;
   top->data_i = 0;
   top->cfg_mode_i = 0;
   top->cfg_bit_i = 0;
@@ -803,7 +792,7 @@ int main(int argc, char** argv) {
   for (int r = 0; r < o.repeat; ++r) {
     for (uint64_t i = r == 0 ? first_i : 0; i < play; ++i, ++cycle) {
       const Instr& in = seq[i];
-      top->ident_i = in.ident;
+      top->id_i = in.ident;
       top->data_i = in.data;
 #ifdef DE_TRACE
       if (slow) {
@@ -825,7 +814,7 @@ int main(int argc, char** argv) {
         }
         if (stop) {
           const long long line = line_of_slot(static_cast<long long>(cycle));
-          std::printf("break: cycle %llu, line %lld (of the instruction on ident_i)",
+          std::printf("break: cycle %llu, line %lld (of the instruction on id_i)",
                       static_cast<unsigned long long>(cycle), line);
           if (brk_probe)
             std::printf(", PE %d (column %d) receives identifier 0x%03x",
@@ -858,10 +847,10 @@ int main(int argc, char** argv) {
 #else
       tick();
 #endif
-      if (top->pixel_valid_o && r == 0) pixels.push_back(top->pixel_o);
-      if (o.trace_pixels && top->pixel_valid_o)
+      if (top->pix_valid_o && r == 0) pixels.push_back(top->pix_o);
+      if (o.trace_pixels && top->pix_valid_o)
         std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(cycle + 1),
-                    pixels.size() - 1, top->pixel_o);
+                    pixels.size() - 1, top->pix_o);
       if (o.trace_pixels && in.ident == kRefresh)
         std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(cycle + 1));
       if (top->pix_collision_o && !collided) {

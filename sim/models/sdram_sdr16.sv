@@ -115,14 +115,14 @@ module sdram_sdr16 #(
   output      logic [9:0]          bl_o         // programmed burst length (0 = none)
 );
   // Elaboration checks.
-  if (BankBits < 1 || BankBits > 3) begin : g_err_bank
-    $error("sdram_sdr16: BankBits must be 1..3");
+  if (BankBits < 1 || BankBits > 3) begin : g_bad_bank
+    $fatal(1, "sdram_sdr16: BankBits must be 1..3");
   end
-  if (ColBits < 8 || ColBits > 12 || RowBits < 11 || RowBits > 14) begin : g_err_geom
-    $error("sdram_sdr16: ColBits 8..12, RowBits 11..14");
+  if (ColBits < 8 || ColBits > 12 || RowBits < 11 || RowBits > 14) begin : g_bad_geom
+    $fatal(1, "sdram_sdr16: ColBits 8..12, RowBits 11..14");
   end
-  if (TckPs < 1000) begin : g_err_tck
-    $error("sdram_sdr16: TckPs must be >= 1000");
+  if (TckPs < 1000) begin : g_bad_tck
+    $fatal(1, "sdram_sdr16: TckPs must be >= 1000");
   end
 
   // Error codes (err_code_o, err_seen_o bit).

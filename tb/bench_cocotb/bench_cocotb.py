@@ -35,7 +35,7 @@ async def drive_stream(dut):
     dut.rst_i.value = 0
     t = time.perf_counter()
     for ident, data in slots:
-        dut.ident_i.value = ident
+        dut.id_i.value = ident
         dut.data_i.value = data
         await RisingEdge(dut.clk_i)
     secs = time.perf_counter() - t

@@ -27,17 +27,17 @@ from cocotb.utils import get_sim_time
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
+sys.path.insert(0, str(ROOT / "sw"))
+from diffengine import isa  # noqa: E402
 
-REFRESH = 0x100 << 36
-MARKER = 0x100 << 36
+W = isa.WORD_BITS
+REFRESH = isa.REFRESH << W
+MARKER = isa.REFRESH << W
 TEST_MODE = dict(ha=16, hfp=2, hs=3, hbp=3, va=6, vfp=1, vs=2, vbp=2, hpol=0, vpol=0)
-MODES = {
-    0: dict(ha=640, hfp=16, hs=96, hbp=48, va=480, vfp=10, vs=2, vbp=33, hpol=0, vpol=0),
-    1: dict(ha=640, hfp=8, hs=24, hbp=11, va=485, vfp=11, vs=2, vbp=27, hpol=0, vpol=0),
-    2: dict(ha=1280, hfp=48, hs=112, hbp=248, va=1024, vfp=1, vs=3, vbp=38, hpol=1,
-            vpol=1),
-    3: TEST_MODE,
-}
+# The fixed modes from spec/video.toml (isa.VIDEO_MODES), the test mode from this build.
+MODES = {i: dict(zip(("ha", "hfp", "hs", "hbp"), h)) | dict(zip(("va", "vfp", "vs", "vbp"), v))
+         | dict(hpol=int(hp), vpol=int(vp)) for i, (_, h, v, hp, vp) in isa.VIDEO_MODES.items()}
+MODES[isa.VIDEO_MODE_TEST] = TEST_MODE
 PERIOD_NS = 10
 
 
@@ -129,11 +129,12 @@ async def test_timing_modes(dut):
 # Cycle-exact reference model of the controller's bus logic (docs/display-controller.md).
 
 def is_start(w):
-    return (w >> 45) & 3 == 0
+    # A command starts with a slot of no DATA / ACC class bit.
+    return (w >> W) & (isa.ID_DATA | isa.ID_ACC) == 0
 
 
 def is_marker(w):
-    return (w >> 36) == 0x100
+    return (w >> W) == isa.REFRESH
 
 
 class Model:
@@ -218,9 +219,11 @@ class Model:
 def make_cmd(rng, max_len=5):
     n = rng.choice([1, 1, 2, 3, 4, 5][:max_len])
     if n == 1:
-        return [(rng.choice([0x802, 0x803, 0x001]) << 36) | rng.getrandbits(36)]
-    ids = [0x800] + [rng.choice([0x444, 0x484, 0x4B4]) for _ in range(n - 2)] + [0x200]
-    return [(i << 36) | rng.getrandbits(36) for i in ids]
+        return [(rng.choice([isa.ADDR_EVAL0, isa.ADDR_DIS, isa.ACCMODE_ON]) << W)
+                | rng.getrandbits(W)]
+    ids = [isa.ADDR_RANGE] + [rng.choice([isa.D_A, isa.D_B, isa.D_B_C]) for _ in range(n - 2)] \
+        + [isa.ACC]
+    return [(i << W) | rng.getrandbits(W) for i in ids]
 
 
 async def run_vs_model(dut, rng, n_cycles, feed_p, cmds_per_line, pre_lines=0,
@@ -290,10 +293,10 @@ async def test_fair_rr(dut):
             # Every active buffer holds 40 commands then its marker (overload).
             bufs = {i: deque() for i in active}
             for i in active:
-                ids = [0x802] if cmd_len == 1 else [0x800, 0x444, 0x200]
+                ids = [isa.ADDR_EVAL0] if cmd_len == 1 else [isa.ADDR_RANGE, isa.D_A, isa.ACC]
                 for c in range(40):
                     for ident in ids:
-                        bufs[i].append((ident << 36) | (i << 8) | c)
+                        bufs[i].append((ident << W) | (i << 8) | c)
                 bufs[i].append(MARKER)
             grants = []
             for _ in range((vt - TEST_MODE["va"]) * ht + 2):

@@ -66,7 +66,7 @@ class Array:
 
     async def reset(self):
         d = self.dut
-        for sig in (d.ident_i, d.data_i, d.cfg_mode_i, d.cfg_bit_i, d.obs_load_i,
+        for sig in (d.id_i, d.data_i, d.cfg_mode_i, d.cfg_bit_i, d.obs_load_i,
                     d.obs_shift_i):
             sig.value = 0
         d.rst_i.value = 1
@@ -93,15 +93,15 @@ class Array:
     async def play(self, slots):
         d = self.dut
         for ident, data in slots:
-            d.ident_i.value = ident
+            d.id_i.value = ident
             d.data_i.value = data
             await RisingEdge(d.clk_i)
             await ReadOnly()
             self.edge += 1
             if ident == isa.REFRESH:
                 self.refresh_edges.append(self.edge)
-            if int(d.pixel_valid_o.value):
-                self.pixels.append(int(d.pixel_o.value))
+            if int(d.pix_valid_o.value):
+                self.pixels.append(int(d.pix_o.value))
                 self.pixel_edges.append(self.edge)
             if self.model:
                 self.model.step(ident, data)
@@ -177,8 +177,8 @@ async def directed_boundaries(dut):
     await arr.play(spaced(isa.serialise(cmds), n))
     want = functional.render(cmds, n, carry_bug=carry_bug(dut))
     np.testing.assert_array_equal(arr.frame(), want)
-    # docs/array.md: a Refresh on ident_i in the cycle ending with edge R puts column q
-    # on pixel_o after edge R + NumChips + 2 + q.
+    # docs/array.md: a Refresh on id_i in the cycle ending with edge R puts column q
+    # on pix_o after edge R + NumChips + 2 + q.
     k = arr.k
     for line, r in enumerate(arr.refresh_edges):
         edges = arr.pixel_edges[line * n:(line + 1) * n]
@@ -206,13 +206,18 @@ async def observation_chain(dut):
     slots = isa.serialise(cmds)[:-1]  # stop mid-stream so flags are set
     await arr.play(slots)
     d = dut
-    d.ident_i.value, d.data_i.value = 0, 0
+    d.id_i.value, d.data_i.value = 0, 0
     d.obs_load_i.value = 1
     await RisingEdge(d.clk_i)   # the load samples the state after the last slot
     await FallingEdge(d.clk_i)
     d.obs_load_i.value = 0
     d.obs_shift_i.value = 1
-    obs_w = 31
+    flag_names = ("pA", "pB", "pC", "dis", "lock", "acc_mode", "act")
+    ctl_names = ("xz1", "act1", "prot1", "c1", "act2", "prot2", "c2", "e0wr2",
+                 "accen2", "accc2", "accen3", "accc3")
+    width = dict(st.DBG_FIELDS)
+    # The observation word: the flags, id1 and the control bits (spec/isa.toml [debug]).
+    obs_w = sum(width[n] for n in flag_names + ("id1",) + ctl_names)
     bits = []
     for _ in range(arr.n * obs_w):
         await ReadOnly()
@@ -230,13 +235,12 @@ async def observation_chain(dut):
         dbg = arr.history[t - lag][q]
         f = lambda name: (dbg >> pos[name][0]) & ((1 << pos[name][1]) - 1)  # noqa: E731
         flags = 0
-        for name in ("pA", "pB", "pC", "dis", "lock", "acc_mode", "act"):
+        for name in flag_names:
             flags = (flags << 1) | f(name)
         ctl = 0
-        for name in ("xz1", "act1", "prot1", "c1", "act2", "prot2", "c2", "e0wr2",
-                     "accen2", "accc2", "accen3", "accc3"):
+        for name in ctl_names:
             ctl = (ctl << 1) | f(name)
-        want = (((flags << 12) | f("id1")) << 12) | ctl
+        want = (((flags << width["id1"]) | f("id1")) << len(ctl_names)) | ctl
         assert word == want, f"PE {q}: observed {word:#010x}, model {want:#010x}"
 
 

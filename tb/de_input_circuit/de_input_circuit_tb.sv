@@ -8,7 +8,7 @@ module de_input_circuit_tb (
   input  logic [2:0]  window_i,
   input  logic        compensate_i,
   output logic        valid_o,
-  output logic [11:0] ident_o,
+  output logic [11:0] id_o,
   output logic [35:0] data_o,
   output logic [11:0] skew_ident_o,
   output logic [11:0] skew_blk0_o,
@@ -19,16 +19,16 @@ module de_input_circuit_tb (
 );
   de_data_mapper u_mapper (
     .clk_i, .rst_i, .valid_i, .word_i, .window_i, .compensate_i,
-    .valid_o, .ident_o, .data_o
+    .valid_o, .id_o, .data_o
   );
   de_skew u_skew (
-    .clk_i, .rst_i, .ident_i(ident_o), .data_i(data_o),
-    .ident_o(skew_ident_o), .blk0_o(skew_blk0_o), .blk1_o(skew_blk1_o),
+    .clk_i, .rst_i, .id_i(id_o), .data_i(data_o),
+    .id_o  (skew_ident_o), .blk0_o(skew_blk0_o), .blk1_o(skew_blk1_o),
     .blk2_o(skew_blk2_o)
   );
   de_deskew u_deskew (
-    .clk_i, .rst_i, .ident_i(skew_ident_o), .blk0_i(skew_blk0_o),
+    .clk_i, .rst_i, .id_i(skew_ident_o), .blk0_i(skew_blk0_o),
     .blk1_i(skew_blk1_o), .blk2_i(skew_blk2_o),
-    .ident_o(deskew_ident_o), .data_o(deskew_data_o)
+    .id_o  (deskew_ident_o), .data_o(deskew_data_o)
   );
 endmodule

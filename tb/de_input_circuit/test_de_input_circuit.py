@@ -48,7 +48,7 @@ async def mapper_matches_model(dut):
         ident, data = map_word(word, window, bool(comp)) if valid else (0, 0)
         await RisingEdge(dut.clk_i)      # the mapper registers this word
         await ReadOnly()
-        got = (int(dut.valid_o.value), int(dut.ident_o.value), int(dut.data_o.value))
+        got = (int(dut.valid_o.value), int(dut.id_o.value), int(dut.data_o.value))
         assert got == (int(valid), ident, data), (
             f"word 0x{word:08x} window {window} comp {comp}: got valid/ident/data "
             f"{got[0]}/0x{got[1]:03x}/0x{got[2]:09x}, want {int(valid)}/0x{ident:03x}/0x{data:09x}")

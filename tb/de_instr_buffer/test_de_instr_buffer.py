@@ -20,16 +20,20 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
+sys.path.insert(0, str(ROOT / "sw"))
+from diffengine import isa  # noqa: E402
 
-ID_MARKER = 0x100
+W = isa.WORD_BITS
+ID_MARKER = isa.REFRESH
 
 
 def is_start(word: int) -> bool:
-    return ((word >> 36) >> 9) & 0b11 == 0
+    # A command starts with a slot of no DATA / ACC class bit.
+    return (word >> W) & (isa.ID_DATA | isa.ID_ACC) == 0
 
 
 def is_marker(word: int) -> bool:
-    return (word >> 36) == ID_MARKER
+    return (word >> W) == ID_MARKER
 
 
 def random_stream(rng: random.Random, n_lines: int, max_cmds: int,
@@ -40,16 +44,17 @@ def random_stream(rng: random.Random, n_lines: int, max_cmds: int,
     for _ in range(n_lines):
         for _ in range(rng.randint(0, max_cmds)):
             n = min(max_len, rng.choice([1, 1, 2, 3, 4, 5]))
-            ids = [rng.choice([0x800, 0x801, 0x802, 0x803, 0x001, 0x002, 0x000])]
+            ids = [rng.choice([isa.ADDR_RANGE, isa.ADDR_PERIODIC, isa.ADDR_EVAL0,
+                               isa.ADDR_DIS, isa.ACCMODE_ON, isa.ACCMODE_OFF, isa.NOP])]
             if n > 1:
-                ids[0] = 0x800
-                ids += [rng.choice([0x444, 0x484, 0x4C4, 0x4B4, 0x464, 0x448])
+                ids[0] = isa.ADDR_RANGE
+                ids += [rng.choice([isa.D_A, isa.D_B, isa.D_C, isa.D_B_C, isa.D_A_B, isa.SET_A])
                         for _ in range(n - 2)]
-                ids.append(rng.choice([0x200, 0x448, 0x488]))
+                ids.append(rng.choice([isa.ACC, isa.SET_A, isa.SET_B]))
             for ident in ids:
-                words.append((ident << 36) | (seq & 0xFFFF) | (rng.getrandbits(20) << 16))
+                words.append((ident << W) | (seq & 0xFFFF) | (rng.getrandbits(20) << 16))
                 seq += 1
-        words.append((ID_MARKER << 36) | (seq & 0xFFFF))
+        words.append((ID_MARKER << W) | (seq & 0xFFFF))
         seq += 1
     return words
 
@@ -164,15 +169,16 @@ async def test_commit_gating(dut):
         await RisingEdge(dut.clk_i)
         return v
 
-    assert await write(0x800 << 36) == (0, 0)           # ADDR: command may go on
-    assert await write(0x444 << 36) == (0, 0)           # DATA
-    assert await write(0x200 << 36) == (0, 0)           # ACC: end not yet known
-    assert await write(0x802 << 36) == (1, 3)           # next start commits the Eval1
-    assert await write(ID_MARKER << 36) == (1, 5)       # marker commits Eval0 + itself
+    assert await write(isa.ADDR_RANGE << W) == (0, 0)   # ADDR: command may go on
+    assert await write(isa.D_A << W) == (0, 0)          # DATA
+    assert await write(isa.ACC << W) == (0, 0)          # ACC: end not yet known
+    assert await write(isa.ADDR_EVAL0 << W) == (1, 3)   # next start commits the Eval1
+    assert await write(ID_MARKER << W) == (1, 5)       # marker commits Eval0 + itself
 
 
 def _build_and_run(depth: int, max_cmd_len: int):
     from cocotb_tools.runner import get_runner
+    from common.run import rtl_files
 
     sys.path.insert(0, str(HERE))
     seed = get_seed()
@@ -180,7 +186,7 @@ def _build_and_run(depth: int, max_cmd_len: int):
     runner = get_runner("verilator")
     build_dir = HERE / f"sim_build_Depth{depth}_MaxCmdLen{max_cmd_len}"
     runner.build(
-        sources=[ROOT / "rtl/ctrl/de_instr_buffer.sv"],
+        sources=rtl_files("display_core", "instr_buffer"),   # rtl/ctrl/de_display_core.core
         hdl_toplevel="de_instr_buffer",
         parameters={"Depth": depth, "MaxCmdLen": max_cmd_len},
         build_dir=build_dir,

@@ -152,6 +152,7 @@ async def test_counts_under_overload(dut):
 
 def _build_and_run(nb: int, bins: int, shift: int):
     from cocotb_tools.runner import get_runner
+    from common.run import rtl_files
 
     sys.path.insert(0, str(HERE))
     seed = get_seed()
@@ -160,7 +161,7 @@ def _build_and_run(nb: int, bins: int, shift: int):
     build_dir = HERE / f"sim_build_NumBuf{nb}_Bins{bins}_Shift{shift}"
     params = {"NumBuf": nb, "NumBins": bins, "BinShift": shift, "MaxLines": 16}
     runner.build(
-        sources=[ROOT / "rtl/ctrl/de_load_monitor.sv"],
+        sources=rtl_files("display_core", "load_monitor"),   # rtl/ctrl/de_display_core.core
         hdl_toplevel="de_load_monitor",
         parameters=params,
         build_dir=build_dir,

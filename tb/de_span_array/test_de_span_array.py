@@ -47,15 +47,15 @@ class Bench:
             await RisingEdge(d.clk_i)
             await ReadOnly()
             self.cycle += 1
-            if int(d.pixel_valid_o.value):
-                self.pixels.append((int(d.pixel_col_o.value), int(d.pixel_o.value)))
+            if int(d.pix_valid_o.value):
+                self.pixels.append((int(d.pix_col_o.value), int(d.pix_o.value)))
                 if len(self.pixels) % self.n == 0:
                     self.refresh_cycles.append(self.cycle)
 
     async def reset(self):
         d = self.dut
         d.instr_valid_i.value = 0
-        d.ident_i.value = 0
+        d.id_i.value = 0
         d.data_i.value = 0
         d.rst_i.value = 1
         await RisingEdge(d.clk_i)
@@ -67,7 +67,7 @@ class Bench:
         returns at the falling edge after the clock that took it."""
         d = self.dut
         d.instr_valid_i.value = 1
-        d.ident_i.value = ident
+        d.id_i.value = ident
         d.data_i.value = data
         while True:
             await ReadOnly()
@@ -196,11 +196,11 @@ async def slot_soup(dut):
     slots = []
     for _ in range(int(os.environ.get("N_SLOTS", 1500))):
         ident = rng.choices(ids, weights)[0]
-        if ident & 0x800:
+        if ident & isa.ID_ADDR:
             x = rng.choice([0, rng.randrange(n), n - 1, n + rng.randrange(3)])
             dx = rng.choice([0, 1, rng.randrange(1, n + 4), rng.randrange(4096)])
             data = x | dx << 12 | rng.randrange(4096) << 24
-        elif ident & 0x400:
+        elif ident & isa.ID_DATA:
             data = rng.randrange(1 << 36) if rng.random() < 0.3 else \
                 isa.to_word(rng.randrange(-8 * ONE, 8 * ONE))
         else:

@@ -8,7 +8,7 @@ module tb_de_span_video #(
   input  logic        clk_i,
   input  logic        clk_core_i,
   input  logic        rst_i,
-  input  logic [11:0] ident_i,
+  input  logic [11:0] id_i,
   input  logic [35:0] data_i,
   output logic        a_pixel_valid_o,
   output logic [11:0] a_pixel_o,
@@ -25,16 +25,16 @@ module tb_de_span_video #(
   /* verilator lint_on UNUSEDSIGNAL */
 
   de_array #(.NumChips(NumChips), .CarryBug(CarryBug)) u_array (
-    .clk_i, .rst_i, .ident_i, .data_i,
-    .ident_o(ident_out), .data_o(data_out),
-    .pixel_valid_o(a_pixel_valid_o), .pixel_o(a_pixel_o), .n_pe_o(n_pe),
+    .clk_i, .rst_i, .id_i, .data_i,
+    .id_o           (ident_out), .data_o(data_out),
+    .pix_valid_o    (a_pixel_valid_o), .pix_o(a_pixel_o), .n_pe_o(n_pe),
     .pix_collision_o(coll), .cfg_mode_i(1'b0), .cfg_bit_i(1'b0), .cfg_bit_o(cfg_o),
     .obs_load_i(1'b0), .obs_shift_i(1'b0), .obs_bit_o(obs_o)
   );
 
   de_span_video #(.NumCols(9 * NumChips), .CarryBug(CarryBug), .Latency(Latency),
                   .NumLineBuf(8)) u_span (
-    .clk_i, .rst_i, .clk_core_i, .ident_i, .data_i,
-    .pixel_valid_o(s_pixel_valid_o), .pixel_o(s_pixel_o), .late_o, .overflow_o
+    .clk_i, .rst_i, .clk_core_i, .id_i, .data_i,
+    .pix_valid_o             (s_pixel_valid_o), .pix_o(s_pixel_o), .late_o, .overflow_o
   );
 endmodule

@@ -46,7 +46,7 @@ async def run(dut, slots, seed: int):
     cocotb.start_soon(Clock(dut.clk_i, PIX_PS, unit="ps").start())
     await Timer(rng.randrange(1, core_ps), unit="ps")       # random phase
     cocotb.start_soon(Clock(dut.clk_core_i, core_ps, unit="ps").start())
-    dut.ident_i.value = 0
+    dut.id_i.value = 0
     dut.data_i.value = 0
     dut.rst_i.value = 1
     for _ in range(8):
@@ -60,7 +60,7 @@ async def run(dut, slots, seed: int):
     a, s = [], []
     for ident, data in slots:
         await FallingEdge(dut.clk_i)
-        dut.ident_i.value = ident
+        dut.id_i.value = ident
         dut.data_i.value = data
         await RisingEdge(dut.clk_i)
         await ReadOnly()

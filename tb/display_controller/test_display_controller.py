@@ -46,7 +46,7 @@ from diffengine import isa
 from diffengine.regress import randgen
 
 NCH = 3
-REFRESH_ID = 0x100
+REFRESH_ID = isa.REFRESH
 MASK48 = (1 << 48) - 1
 
 

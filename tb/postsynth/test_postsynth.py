@@ -58,7 +58,7 @@ async def netlist_frames(dut):
     fold = int(os.environ.get("DE_FOLD", "0"))   # 0: plain array (one slot per clock)
     bug = bool(int(os.environ.get("DE_CARRY_BUG", "0")))
     cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
-    for name in ("ident_i", "data_i", "cfg_mode_i", "cfg_bit_i", "obs_load_i", "obs_shift_i"):
+    for name in ("id_i", "data_i", "cfg_mode_i", "cfg_bit_i", "obs_load_i", "obs_shift_i"):
         getattr(dut, name).value = 0
     dut.rst_i.value = 1
     await Timer(1, unit="ns")
@@ -73,12 +73,12 @@ async def netlist_frames(dut):
         await FallingEdge(dut.clk_i)
         while fold and not int(dut.step_o.value):   # registers only: settled here
             await FallingEdge(dut.clk_i)
-        dut.ident_i.value = ident
+        dut.id_i.value = ident
         dut.data_i.value = data
         await RisingEdge(dut.clk_i)
         await ReadOnly()
-        if int(dut.pixel_valid_o.value):
-            pixels.append(int(dut.pixel_o.value))
+        if int(dut.pix_valid_o.value):
+            pixels.append(int(dut.pix_o.value))
     assert not int(dut.pix_collision_o.value)
     want = functional.render(cmds, n, carry_bug=bug)
     assert len(pixels) == want.size, f"{len(pixels)} pixels, golden model {want.size}"

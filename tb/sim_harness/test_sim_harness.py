@@ -148,7 +148,7 @@ def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
     c, rows = stopped(run(exe, src, tmp_path / "o", "--break-cycle", 57, "--trace-pes",
                           "8-10", rc=3))
     assert c == 57 and rows == [by_key[("57", str(p))] for p in (8, 9, 10)]
-    # At a scanline: its first instruction is on ident_i. A dump stops there too, with
+    # At a scanline: its first instruction is on id_i. A dump stops there too, with
     # its save file.
     c, _ = stopped(run(exe, src, tmp_path / "o", "--break-line", 2, "--fst",
                        tmp_path / "b.fst", rc=3))
@@ -159,7 +159,7 @@ def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
     res = run(exe, src, tmp_path / "o", "--break-pe", 10, "--break-op", "acc", rc=3)
     c, rows = stopped(res)
     assert c == k + 10 + 1
-    assert "PE 10 (column 10) receives identifier 0x200" in res.stdout
+    assert f"PE 10 (column 10) receives identifier {isa.ACC:#05x}" in res.stdout
     assert [r.split(",")[1] for r in rows] == ["9", "10", "11"]
     assert rows[1].split(",")[2] == "200"
     # The same breakpoint from the model engine prints the same.
@@ -167,7 +167,7 @@ def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
                           break_op=isa.ACC)
     assert m.stop.splitlines() == res.stdout.splitlines()[:5]
     # Numeric identifiers work too, and the op table is isa.LUT.
-    assert stopped(run(exe, src, tmp_path / "o", "--break-pe", 10, "--break-op", "0x200",
+    assert stopped(run(exe, src, tmp_path / "o", "--break-pe", 10, "--break-op", f"{isa.ACC:#05x}",
                        rc=3))[0] == c
     listed = run(exe, src, tmp_path / "o", "--list-ops").stdout.split()
     assert dict(zip(listed[::2], (int(v, 16) for v in listed[1::2]))) == {

@@ -59,11 +59,17 @@ class VideoMode:
         return (self.htotal - 1) * self.vactive * self.fps
 
 
+def _controller_mode(index: int, fps: int) -> VideoMode:
+    _, h, v, _, _ = isa.VIDEO_MODES[index]
+    return VideoMode(h[0], v[0], sum(h), sum(v), fps)
+
+
 MODES = {
     "640x485@50": VideoMode(640, 485, 820, 525, 50),        # the source's low-res mode
     "1280x1024@50": VideoMode(1280, 1024, 1720, 1066, 50),  # the source's high-res mode
-    "640x480@60": VideoMode(640, 480, 800, 525, 60),        # VGA, 25.2 MHz
-    "1280x1024@60": VideoMode(1280, 1024, 1688, 1066, 60),  # VESA, 108 MHz
+    # The controller's modes 0 and 2 (spec/video.toml).
+    "640x480@60": _controller_mode(0, 60),                  # VGA, 25.2 MHz
+    "1280x1024@60": _controller_mode(2, 60),                # VESA, 108 MHz
 }
 TABLE_MODES = ("640x485@50", "1280x1024@50")
 SIZES = (10, 100)

@@ -58,13 +58,11 @@ BINOM = _binomials(isa.MAX_EVAL_ORDER, MAX_COLS)
 
 def bug_add(a: int, b: int) -> int:
     """The faulty adder of §7.7: the carry out of bit 23 lands in bit 25."""
-    low = (a & 0xFFFFFF) + (b & 0xFFFFFF)
-    high = (a >> 24) + (b >> 24) + 2 * (low >> 24)
-    return ((high & 0xFFF) << 24) | (low & 0xFFFFFF)
+    return isa.add_word(a, b, carry_bug=True)  # generated from spec/isa.toml [adder]
 
 
 def _add(a: int, b: int) -> int:
-    return (a + b) & isa.WORD_MASK
+    return isa.add_word(a, b)
 
 
 def _prot_levels(order: int) -> dict[int, int]:

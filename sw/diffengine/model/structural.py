@@ -32,28 +32,21 @@ R_NONE, R_A, R_B, R_C, R_D = 0, 1, 2, 3, 4
 # Layout of the RTL's debug vector `dbg_o` (rtl/xproc/de_pe.sv), MSB first. The
 # testbench slices the vector with this table and compares it with `Array.state()`.
 # Any change here must be mirrored in de_pe.sv (and vice versa).
-DBG_FIELDS: list[tuple[str, int]] = [
-    ("A", 36), ("B", 36), ("C", 36), ("D", 36),
-    ("pA", 1), ("pB", 1), ("pC", 1), ("dis", 1), ("lock", 1), ("acc_mode", 1), ("act", 1),
-    ("id1", 12), ("id2", 12), ("out", 36),
-    ("xz1", 1), ("act1", 1), ("prot1", 1), ("c1", 1), ("act2", 1), ("prot2", 1), ("c2", 1),
-    ("e0wr2", 1), ("accen2", 1), ("accc2", 1), ("accen3", 1), ("accc3", 1),
-    ("pix_valid", 1), ("pix", 12),
-]
+DBG_FIELDS: list[tuple[str, int]] = isa.DBG_FIELDS  # spec/isa.toml [debug]
 DBG_WIDTH = sum(w for _, w in DBG_FIELDS)
 
 
 def _dec(ident: np.ndarray) -> dict[str, np.ndarray]:
     """Split identifiers into the fields of docs/isa.md §3 (vectorised)."""
     return {
-        "addr": ((ident >> 11) & 1).astype(bool),
-        "data": ((ident >> 10) & 1).astype(bool),
-        "acc": ((ident >> 9) & 1).astype(bool),
-        "ref": ((ident >> 8) & 1).astype(bool),
-        "dst": (ident >> isa.DST_SHIFT) & 3,
-        "src": (ident >> isa.SRC_SHIFT) & 3,
-        "set": ((ident >> 3) & 1).astype(bool),
-        "prot": ((ident >> 2) & 1).astype(bool),
+        "addr": (ident & isa.ID_ADDR).astype(bool),
+        "data": (ident & isa.ID_DATA).astype(bool),
+        "acc": (ident & isa.ID_ACC).astype(bool),
+        "ref": (ident & isa.ID_REFRESH).astype(bool),
+        "dst": (ident >> isa.DST_SHIFT) & isa.DST_MASK,
+        "src": (ident >> isa.SRC_SHIFT) & isa.SRC_MASK,
+        "set": (ident & isa.ID_SET).astype(bool),
+        "prot": (ident & isa.ID_PROT).astype(bool),
         "sub": ident & isa.SUB_MASK,
     }
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import REPO
+from .. import REPO, isa
 from ..formats import binfmt, frame
 from ..model import functional
 from .demo import build_yproc
@@ -32,7 +32,7 @@ def lines_of_de48(path) -> list[bytes]:
     words = data[8:]
     out, start = [], 0
     for i in range(0, len(words), 6):
-        if (int.from_bytes(words[i:i + 2], "big") >> 4) == 0x100:
+        if (int.from_bytes(words[i:i + 2], "big") >> 4) == isa.REFRESH:
             out.append(words[start:i + 6])
             start = i + 6
     if start != len(words):
@@ -57,7 +57,7 @@ def read_delta(path) -> tuple[int, int, int, list[dict[int, bytes]]]:
             y, k = struct.unpack(">HI", data[pos:pos + 6])
             pos += 6
             ch[y] = data[pos:pos + 6 * k]
-            if len(ch[y]) != 6 * k or (int.from_bytes(ch[y][-6:-4], "big") >> 4) != 0x100:
+            if len(ch[y]) != 6 * k or (int.from_bytes(ch[y][-6:-4], "big") >> 4) != isa.REFRESH:
                 raise ValueError(f"{path}: line {y} is truncated or lacks its Refresh")
             pos += 6 * k
         chans.append(ch)

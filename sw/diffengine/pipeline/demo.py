@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import REPO
+from .. import REPO, isa
 from ..formats import binfmt, frame
 from ..host import yproc
 from ..model import functional, reference
@@ -30,7 +30,10 @@ from ..rtl import dc_harness
 
 YPROC = yproc.YPROC
 MIN_PSNR = 38.0
-H_TOTAL = 800          # 640x480's line: a 799-slot window, 798 usable (docs/pipeline.md 1.1)
+# Mode 0 (640x480, spec/video.toml): its line of 800 is a 799-slot window, 798 usable
+# (docs/pipeline.md 1.1); test-mode screens keep its line length and its HFp / HSync.
+_, (_, H_FP, H_SYNC, _), _, _, _ = isa.VIDEO_MODES[0]
+H_TOTAL = sum(isa.VIDEO_MODES[0][1])
 
 
 class PipelineError(RuntimeError):
@@ -99,16 +102,16 @@ def controller_setup(width: int, height: int, chips: int) -> tuple[int, tuple]:
                             f"{width} columns (need at least {-(-width // 9)} chips)")
     if (width, height) == (640, 480):
         return 0, dc_harness.DEFAULT_TEST
-    if width + 16 + 96 + 1 > H_TOTAL:
+    if width + H_FP + H_SYNC + 1 > H_TOTAL:
         raise PipelineError(f"screen width {width}: only 640x480 or widths up to "
-                            f"{H_TOTAL - 113} (test mode) are supported")
-    return 3, (width, 16, 96, H_TOTAL - width - 112, height, 1, 2, 2)
+                            f"{H_TOTAL - H_FP - H_SYNC - 1} (test mode) are supported")
+    return 3, (width, H_FP, H_SYNC, H_TOTAL - width - H_FP - H_SYNC, height, 1, 2, 2)
 
 
 def capacity(mode: int, test: tuple) -> int:
     """Command slots a line can really use in the controller: HTotal - 2 (not HTotal - 1,
     the window: the end-of-line marker must reach the buffer's head inside the window)."""
-    htotal = {0: 800, 1: 683, 2: 1688}.get(mode) or sum(test[:4])
+    htotal = sum(isa.VIDEO_MODES[mode][1]) if mode in isa.VIDEO_MODES else sum(test[:4])
     return htotal - 2
 
 

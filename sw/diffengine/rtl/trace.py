@@ -24,7 +24,7 @@ from .. import isa
 from ..formats import binfmt
 from .harness import PE_PER_CHIP
 
-PIX_LATENCY = 3  # docs/array.md: column q of a Refresh on ident_i in cycle R leaves at R+NumChips+3+q
+PIX_LATENCY = 3  # docs/array.md: column q of a Refresh on id_i in cycle R leaves at R+NumChips+3+q
 
 COLUMNS = ["cycle", "pe", "ident", "data", "A", "B", "C", "D", "flags", "id1", "id2", "out",
            "c1", "c2", "accc2", "accc3", "xz1", "act1", "prot1", "act2", "prot2", "e0wr2",
@@ -62,7 +62,7 @@ class Timing:
     n_pe: int
     chips: int
     seq: list
-    refresh_at: list  # cycle of each Refresh on ident_i, line by line
+    refresh_at: list  # cycle of each Refresh on id_i, line by line
 
     @classmethod
     def of(cls, slots, chips: int) -> "Timing":
@@ -79,15 +79,15 @@ class Timing:
             raise TraceError(f"{opt} {line}: the stream has lines 0..{len(self.refresh_at) - 1}")
 
     def line_window(self, line: int) -> tuple[int, int]:
-        """Cycles of scanline L: from Refresh L-1 on ident_i (cycle 0 for L = 0) to the
-        cycle its last pixel is on pixel_o."""
+        """Cycles of scanline L: from Refresh L-1 on id_i (cycle 0 for L = 0) to the
+        cycle its last pixel is on pix_o."""
         self.check_line(line, "--line")
         lo = self.refresh_at[line - 1] if line else 0
         return lo, min(self.refresh_at[line] + self.chips + PIX_LATENCY + self.n_pe - 1,
                        len(self.seq) - 1)
 
     def line_start(self, line: int) -> int:
-        """Breakpoint cycle of scanline L: its first instruction is on ident_i."""
+        """Breakpoint cycle of scanline L: its first instruction is on id_i."""
         self.check_line(line, "--break-line")
         return self.refresh_at[line - 1] + 1 if line else 0
 
@@ -193,7 +193,7 @@ def model_trace(slots, chips: int, carry_bug: bool, pes: list[int], lo: int, hi:
             r = row(c, break_pe).split(",")
             stop = int(r[2], 16) == break_op
         if stop:
-            head = (f"break: cycle {c}, line {t.line_of_slot(c)} (of the instruction on ident_i)"
+            head = (f"break: cycle {c}, line {t.line_of_slot(c)} (of the instruction on id_i)"
                     + (f", PE {break_pe} (column {break_pe}) receives identifier "
                        f"0x{break_op:03x}" if break_pe is not None else ""))
             return Result(rows, "\n".join([head, ",".join(COLUMNS)] + [row(c, p) for p in show]))

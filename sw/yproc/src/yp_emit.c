@@ -6,8 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include "yp_internal.h"
+#include "de_isa.h"
 
-#define M36 ((UINT64_C(1) << 36) - 1)
+#define M36 DE_WORD_MASK
+/* The expected frame is the correct adder's (the product); the prototype's carry fault
+ * is reproduced by the RTL's CarryBug=1 and the golden model, through the same
+ * de_add_word generated from spec/isa.toml. */
+#define YP_CARRY_BUG 0
 
 int yp_cmd_slots(const yp_cmd *c)
 {
@@ -44,16 +49,16 @@ void yp_options_default(yp_options *o)
 
 int yp_mode_capacity(const char *mode, int *width, int *height)
 {
-    static const struct { const char *name; int w, h, htotal; } modes[] = {
-        {"640x480", 640, 480, 800}, {"640x485", 640, 485, 683}, {"1280x1024", 1280, 1024, 1688}};
-    for (size_t i = 0; i < sizeof modes / sizeof modes[0]; i++)
-        if (!strcmp(mode, modes[i].name)) {
-            if (width) *width = modes[i].w;
-            if (height) *height = modes[i].h;
+    for (int i = 0; i < DE_VIDEO_MODES; i++) {
+        const de_video_mode *m = de_video_mode_get(i);
+        if (!strcmp(mode, m->name)) {
+            if (width) *width = m->h[0];
+            if (height) *height = m->v[0];
             /* HTotal - 2: the window has HTotal - 1 slots, and the end-of-line
              * marker must reach the buffer's head inside it (docs/pipeline.md 1.1) */
-            return modes[i].htotal - 2;
+            return de_video_htotal(m) - 2;
         }
+    }
     return 0;
 }
 
@@ -99,7 +104,7 @@ void yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix)
         }
         case YP_EVAL0:
             for (int p = a; p < e; p++) {
-                if (!(fl[p] & 0x18)) { D[p] = (uint64_t)c->v[0] << 24; fl[p] |= 16; }
+                if (!(fl[p] & 0x18)) { D[p] = (uint64_t)c->v[0] << DE_FRAC_BITS; fl[p] |= 16; }
                 fl[p] &= (unsigned char)~0x0f;
             }
             break;
@@ -112,10 +117,10 @@ void yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix)
                 for (int r = ord; r >= 0; r--) v[r] = (fl[p] & (1 << r)) ? R[3 * p + r] : in[r];
                 for (int r = 0; r <= ord; r++) R[3 * p + r] = v[r];
                 uint64_t A = v[0] & M36;
-                int neg = (int)((A >> 35) & 1);
-                if (!(fl[p] & 0x18) && !(accm && neg)) D[p] += A;
+                int neg = (int)((A >> (DE_WORD_BITS - 1)) & 1);
+                if (!(fl[p] & 0x18) && !(accm && neg)) D[p] = de_add_word(D[p], A, YP_CARRY_BUG);
                 fl[p] &= (unsigned char)~0x0f;
-                for (int r = 0; r < ord; r++) in[r] = v[r] + v[r + 1];
+                for (int r = 0; r < ord; r++) in[r] = de_add_word(v[r], v[r + 1], YP_CARRY_BUG);
                 in[ord] = v[ord];
             }
             break;
@@ -123,38 +128,38 @@ void yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix)
         default: break;
         }
     }
-    for (int p = 0; p < width; p++) pix[p] = (uint16_t)(((D[p] & M36) >> 24) & 0xfff);
+    for (int p = 0; p < width; p++) pix[p] = (uint16_t)(((D[p] & M36) >> DE_FRAC_BITS) & DE_BLOCK_MASK);
     free(D); free(R); free(fl);
 }
 
 /* ---- serialisation -------------------------------------------------- */
 static void put48(FILE *f, unsigned ident, uint64_t data)
 {
-    uint64_t w = ((uint64_t)(ident & 0xfff) << 36) | (data & M36);
-    unsigned char b[6];
-    for (int i = 0; i < 6; i++) b[i] = (unsigned char)(w >> (40 - 8 * i));
-    fwrite(b, 1, 6, f);
+    uint64_t w = ((uint64_t)(ident & DE_ID_MASK) << DE_WORD_BITS) | (data & M36);
+    unsigned char b[DE_RECORD_BITS / 8];
+    for (int i = 0; i < DE_RECORD_BITS / 8; i++) b[i] = (unsigned char)(w >> (DE_RECORD_BITS - 8 - 8 * i));
+    fwrite(b, 1, sizeof b, f);
 }
 
 static void put_cmd(FILE *f, const yp_cmd *c)
 {
-    uint64_t rng = (uint64_t)(c->x & 0xfff) | ((uint64_t)(c->dx & 0xfff) << 12);
+    uint64_t rng = (uint64_t)(c->x & DE_BLOCK_MASK) | ((uint64_t)(c->dx & DE_BLOCK_MASK) << DE_BLOCK_BITS);
     switch (c->op) {
-    case YP_REFRESH: put48(f, 0x100, 0); break;
-    case YP_ACCMODE: put48(f, c->v[0] ? 0x001 : 0x002, 0); break;
-    case YP_DIS: put48(f, 0x803, rng); break;
-    case YP_EVAL0: put48(f, 0x802, rng | ((uint64_t)(c->v[0] & 0xfff) << 24)); break;
+    case YP_REFRESH: put48(f, DE_ID_REFRESH, 0); break;
+    case YP_ACCMODE: put48(f, c->v[0] ? DE_ID_ACCMODE_ON : DE_ID_ACCMODE_OFF, 0); break;
+    case YP_DIS: put48(f, DE_ID_ADDR_DIS, rng); break;
+    case YP_EVAL0: put48(f, DE_ID_ADDR_EVAL0, rng | ((uint64_t)(c->v[0] & DE_BLOCK_MASK) << (2 * DE_BLOCK_BITS))); break;
     case YP_SETI: case YP_SETDI: case YP_SETDDI: {
-        static const unsigned set_id[3] = {0x448, 0x488, 0x4C8};
-        put48(f, 0x800, rng); put48(f, set_id[c->op - YP_SETI], (uint64_t)c->v[0]);
+        static const unsigned set_id[3] = {DE_ID_SET_A, DE_ID_SET_B, DE_ID_SET_C};
+        put48(f, DE_ID_ADDR_RANGE, rng); put48(f, set_id[c->op - YP_SETI], (uint64_t)c->v[0]);
         break;
     }
     case YP_EVAL: {
-        put48(f, 0x800, rng);
-        if (c->order == 0) put48(f, 0x444, (uint64_t)c->v[0]);
-        else if (c->order == 1) { put48(f, 0x484, (uint64_t)c->v[1]); put48(f, 0x464, (uint64_t)c->v[0]); }
-        else { put48(f, 0x4C4, (uint64_t)c->v[2]); put48(f, 0x4B4, (uint64_t)c->v[1]); put48(f, 0x464, (uint64_t)c->v[0]); }
-        put48(f, 0x200, 0);
+        put48(f, DE_ID_ADDR_RANGE, rng);
+        if (c->order == 0) put48(f, DE_ID_D_A, (uint64_t)c->v[0]);
+        else if (c->order == 1) { put48(f, DE_ID_D_B, (uint64_t)c->v[1]); put48(f, DE_ID_D_A_B, (uint64_t)c->v[0]); }
+        else { put48(f, DE_ID_D_C, (uint64_t)c->v[2]); put48(f, DE_ID_D_B_C, (uint64_t)c->v[1]); put48(f, DE_ID_D_A_B, (uint64_t)c->v[0]); }
+        put48(f, DE_ID_ACC, 0);
         break;
     }
     default: break;
@@ -179,7 +184,7 @@ hsr_status yp_write_de48(const yp_frame *fr, int colour, const char *path)
 static void fixed(char *buf, size_t n, int64_t v)
 {
     uint64_t w = (uint64_t)v & M36;
-    snprintf(buf, n, "0x%03x.%06x", (unsigned)(w >> 24), (unsigned)(w & 0xffffff));
+    snprintf(buf, n, "0x%03x.%06x", (unsigned)(w >> DE_FRAC_BITS), (unsigned)(w & DE_FRAC_MASK));
 }
 
 void yp_format_cmd(const yp_cmd *c, char *buf, size_t n)

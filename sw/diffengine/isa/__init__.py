@@ -1,36 +1,26 @@
 """The x-processor instruction set: identifiers, commands and their serialisation.
 
 docs/isa.md is the normative text; this module is its executable form. Everything else
-(assembler, golden models, testbenches) builds on the names defined here.
+(assembler, golden models, testbenches) builds on the names defined here. The tables
+(identifier fields, encodings, look-up table, adder, video modes, debug-vector layout)
+are generated from spec/isa.toml and spec/video.toml into _tables.py by
+`python -m diffengine.isa.gen`, which also writes rtl/xproc/de_pkg.sv and
+sw/include/de_isa.h from the same text.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-WORD_BITS = 36
-WORD_MASK = (1 << WORD_BITS) - 1
-FRAC_BITS = 24
-BLOCK_BITS = 12
-BLOCK_MASK = (1 << BLOCK_BITS) - 1
-ADDR_MAX = 4095
-MAX_EVAL_ORDER = 7  # Eval8 = order 7 is the largest EvalN accepted
+from ._tables import *  # noqa: F401,F403 (generated from spec/isa.toml)
+from ._tables import (
+    ACC, ACCMODE_OFF, ACCMODE_ON, ADDR_DIS, ADDR_EVAL0, ADDR_MAX, ADDR_PERIODIC,
+    ADDR_RANGE, BLOCK_BITS, BLOCK_MASK, D_A, D_A_A_NP, D_A_B, D_A_B_NP, D_B, D_B_C, D_C,
+    DST_SHIFT, FRAC_BITS, FRAC_MASK, ID_DATA, ID_PROT, ID_SET, LUT, MAX_EVAL_ORDER,
+    NOP, REFRESH, REG_A, REG_B, REG_C, REG_NONE, SET_A, SET_B, SET_C, SRC_SHIFT,
+    TYPE_ADDR, TYPE_INT, TYPE_NONE, WORD_BITS, WORD_MASK, add_word,
+)
 
-# ---- identifier bit fields (docs/isa.md §3) -------------------------------------
-ID_ADDR = 1 << 11
-ID_DATA = 1 << 10
-ID_ACC = 1 << 9
-ID_REFRESH = 1 << 8
-DST_SHIFT = 6
-SRC_SHIFT = 4
-ID_SET = 1 << 3
-ID_PROT = 1 << 2
-SUB_MASK = 0x3
-
-REG_NONE, REG_A, REG_B, REG_C = 0, 1, 2, 3
 REG_NAMES = {REG_NONE: "-", REG_A: "A", REG_B: "B", REG_C: "C"}
-
-SUB_RANGE, SUB_PERIODIC, SUB_EVAL0, SUB_DIS = 0, 1, 2, 3
-SUB_ACCMODE_ON, SUB_ACCMODE_OFF = 1, 2
 
 
 def data_id(dst: int, src: int, prot: bool) -> int:
@@ -42,50 +32,6 @@ def set_id(dst: int) -> int:
     return ID_DATA | (dst << DST_SHIFT) | ID_SET
 
 
-NOP = 0x000
-REFRESH = ID_REFRESH
-ACCMODE_ON = SUB_ACCMODE_ON
-ACCMODE_OFF = SUB_ACCMODE_OFF
-ADDR_RANGE = ID_ADDR | SUB_RANGE
-ADDR_PERIODIC = ID_ADDR | SUB_PERIODIC
-ADDR_EVAL0 = ID_ADDR | SUB_EVAL0
-ADDR_DIS = ID_ADDR | SUB_DIS
-ACC = ID_ACC
-D_A = data_id(REG_A, REG_NONE, True)
-D_B = data_id(REG_B, REG_NONE, True)
-D_C = data_id(REG_C, REG_NONE, True)
-D_B_C = data_id(REG_B, REG_C, True)
-D_A_B = data_id(REG_A, REG_B, True)
-D_A_B_NP = data_id(REG_A, REG_B, False)
-D_A_A_NP = data_id(REG_A, REG_A, False)
-SET_A = set_id(REG_A)
-SET_B = set_id(REG_B)
-SET_C = set_id(REG_C)
-
-TYPE_NONE, TYPE_ADDR, TYPE_INT = "none", "address", "intensity"
-
-# The instruction look-up table of the prototype (§7.6.2): 5-bit index -> identifier.
-LUT: list[tuple[str, int, str]] = [
-    ("NOP", NOP, TYPE_NONE),
-    ("REFRESH", REFRESH, TYPE_NONE),
-    ("ACCMODE_ON", ACCMODE_ON, TYPE_NONE),
-    ("ACCMODE_OFF", ACCMODE_OFF, TYPE_NONE),
-    ("ADDR_RANGE", ADDR_RANGE, TYPE_ADDR),
-    ("ADDR_PERIODIC", ADDR_PERIODIC, TYPE_ADDR),
-    ("ADDR_EVAL0", ADDR_EVAL0, TYPE_ADDR),
-    ("ADDR_DIS", ADDR_DIS, TYPE_ADDR),
-    ("ACC", ACC, TYPE_NONE),
-    ("D_A", D_A, TYPE_INT),
-    ("D_B", D_B, TYPE_INT),
-    ("D_C", D_C, TYPE_INT),
-    ("D_B_C", D_B_C, TYPE_INT),
-    ("D_A_B", D_A_B, TYPE_INT),
-    ("D_A_B_NP", D_A_B_NP, TYPE_INT),
-    ("D_A_A_NP", D_A_A_NP, TYPE_INT),
-    ("SET_A", SET_A, TYPE_INT),
-    ("SET_B", SET_B, TYPE_INT),
-    ("SET_C", SET_C, TYPE_INT),
-]
 LUT_INDEX = {ident: i for i, (_, ident, _) in enumerate(LUT)}
 ID_NAME = {ident: name for name, ident, _ in LUT}
 ID_TYPE = {ident: typ for _, ident, typ in LUT}
@@ -129,10 +75,10 @@ def compensate(value: int, literal: bool = False) -> int:
     to reproduce and document that discrepancy (docs/isa.md §7).
     """
     word = to_word(value)
-    frac = word & 0xFFFFFF
-    out = (word & ~0xFFFFFF & WORD_MASK) | (frac >> 1)
+    frac = word & FRAC_MASK
+    out = (word & ~FRAC_MASK & WORD_MASK) | (frac >> 1)
     if literal and value < 0:
-        out |= 0x800000
+        out |= 1 << (FRAC_BITS - 1)
     return to_signed(out)
 
 
