@@ -166,7 +166,10 @@ def run(top: str, sources: list[Path], tag: str, env: dict, simulator: str = "ic
     env["PYTHONPATH"] = os.pathsep.join([str(HERE), str(REPO / "tb"), str(REPO / "sw")])
     results = build / "results.xml"
     runner.test(test_module="test_postsynth", hdl_toplevel=top, build_dir=build,
-                test_dir=HERE, extra_env=env, results_xml=str(results), testcase=testcase)
+                test_dir=HERE, extra_env=env, results_xml=str(results),
+                # the exact name: cocotb's `testcase` matches any test ending in it, and
+                # span_netlist_frames ends in netlist_frames
+                test_filter=rf"\.{testcase}$")
 
 
 TIER = pytest.mark.skipif(not int(os.environ.get("DE_POSTSYNTH", "0")),
