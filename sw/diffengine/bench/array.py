@@ -33,7 +33,7 @@ from .. import isa
 from ..formats import binfmt
 from ..model import functional, structural
 from ..regress import randgen
-from ..rtl import harness
+from ..rtl import dc_harness, harness
 from . import record, render as doc
 from .record import loadavg
 
@@ -120,16 +120,19 @@ def build_fast_cold(what: str) -> float:
             shutil.rmtree(ROOT / "sim" / "build" / harness.tag(72), ignore_errors=True)
             return timed_make(["-C", str(ROOT / "sim"), "harness", "CHIPS=72",
                                f"FAST_DIR={pieces}"], cold_env())
-        from diffengine.rtl import dc_harness
         shutil.rmtree(ROOT / "sim" / "build" / dc_harness.Config().tag, ignore_errors=True)
         return timed_make(["-C", str(ROOT / "sim" / "dc"), "harness",
                            *dc_harness.Config().make_vars(), f"FAST_DIR={pieces}"], cold_env())
     finally:
         shutil.rmtree(pieces, ignore_errors=True)
-        # leave the shared build as every other caller expects it
+        # Leave the shared builds as every other caller expects them: a model built against
+        # the scratch pieces names them in its dependency files, so a later make there would
+        # stop at the missing headers (make demo did, after a bench run).
         if what == "72":
             shutil.rmtree(ROOT / "sim" / "build" / harness.tag(72), ignore_errors=True)
             harness.build(72)
+        else:
+            shutil.rmtree(ROOT / "sim" / "build" / dc_harness.Config().tag, ignore_errors=True)
 
 
 def build_baseline(base: Path, what: str) -> float:
