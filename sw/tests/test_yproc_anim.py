@@ -5,7 +5,6 @@ model.  Uses only numpy and diffengine (docs/yproc.md, frame-delta format)."""
 from __future__ import annotations
 
 import json
-import struct
 import sys
 from pathlib import Path
 
@@ -14,6 +13,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 import yproc_common as yc  # noqa: E402
+
+from diffengine.pipeline import anim  # noqa: E402
 
 W, H = 64, 48
 
@@ -24,24 +25,11 @@ def yproc():
 
 
 def read_delta(path: Path):
-    """frameNNN.delta -> frame, {colour: {line: words}}"""
-    d = path.read_bytes()
-    assert d[:4] == b"YPD1"
-    ver, frame, w, h = struct.unpack(">HHHH", d[4:12])
-    assert ver == 1 and (w, h) == (W, H)
-    pos, out = 12, {}
-    for c in "rgb":
-        (n,) = struct.unpack(">I", d[pos:pos + 4])
-        pos += 4
-        lines = {}
-        for _ in range(n):
-            y, slots = struct.unpack(">HI", d[pos:pos + 6])
-            pos += 6
-            lines[y] = d[pos:pos + 6 * slots]
-            pos += 6 * slots
-        out[c] = lines
-    assert pos == len(d)
-    return frame, out
+    """frameNNN.delta -> frame, {colour: {line: words}} (the package's reader, which checks
+    the magic, the version, every line's Refresh and that nothing trails)"""
+    frame, w, h, chans = anim.read_delta(path)
+    assert (w, h) == (W, H)
+    return frame, dict(zip("rgb", chans))
 
 
 def test_anim_deltas_equal_full_rerender(yproc, tmp_path):
