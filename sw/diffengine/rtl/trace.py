@@ -325,10 +325,7 @@ def configure(p: argparse.ArgumentParser) -> None:
 def command(a) -> int:
     try:
         return _run(a)
-    except TraceError as e:
-        print(f"diffengine trace: {e}", file=sys.stderr)
-        return 2
-    except RuntimeError as e:
+    except (TraceError, RuntimeError) as e:   # a bad window or a failed harness run
         print(f"diffengine trace: {e}", file=sys.stderr)
         return 2
 
