@@ -270,6 +270,26 @@ def fig530(args, tmp: Path):
     return out
 
 
+def fig530_orders(rounds=5, sizes=(100, 200, 400)):
+    """Both insertion orders of each stack, alternately in the same run (the machine is
+    shared: only ratios within a run are comparable); best of 5 per call, then the best
+    of `rounds` calls per order and the median of the per-round ratios reversed / forward."""
+    rows = []
+    for kind in ("steps", "spets"):
+        for n in sizes:
+            fw, rv = [], []
+            for _ in range(rounds):
+                fw.append(float(kv(run([BENCH, "stack", kind, n, 5]))["seconds"]))
+                rv.append(float(kv(run([BENCH, "stack", kind, n, 5, "reverse"]))["seconds"]))
+            ratios = sorted(b / a for a, b in zip(fw, rv))
+            rows.append(dict(scene=f"tri-{kind}", n=n, forward=min(fw), reversed=min(rv),
+                             ratio=ratios[len(ratios) // 2]))
+            r = rows[-1]
+            print(f"  tri-{kind} {n}: forward {r['forward'] * 1e3:.3f} ms, reversed "
+                  f"{r['reversed'] * 1e3:.3f} ms, reversed / forward {r['ratio']:.2f}", flush=True)
+    return rows
+
+
 def move_bench(args, tmp: Path):
     """A 12-triangle box in front of the teapot, moved sideways by ~ its size."""
     rows = []
@@ -377,7 +397,7 @@ def command(args) -> int:
     t_start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="bench_hsr_") as td:
         tmp = Path(td)
-        res = info = f530 = mv = None
+        res = info = f530 = mv = orders = None
         if "table" not in args.skip:
             print("Table 5.2: Grid-List efficiency")
             res, info = table52(args, tmp)
@@ -385,6 +405,8 @@ def command(args) -> int:
         if "fig" not in args.skip:
             print("Fig. 5.30: HSR time against triangles")
             f530 = fig530(args, tmp)
+            print("Fig. 5.30: both insertion orders alternately (reversed / forward)")
+            orders = fig530_orders(3 if args.quick else 5)
         if "move" not in args.skip:
             print("Incremental move vs full rebuild")
             mv = move_bench(args, tmp)
@@ -394,7 +416,7 @@ def command(args) -> int:
             "teapot_n": args.teapot_n, "seconds": secs, "cpu": cpu_name(),
             "system": platform.system(), "machine": platform.machine(), "load_start": load0,
             "load_end": os.getloadavg()[0], "table52": res, "table52_info": info,
-            "fig530": f530, "move": mv}
+            "fig530": f530, "fig530_orders": orders, "move": mv}
     rec = run.save(data, args.write and not args.skip)
     text = render(rec)
     print()
@@ -461,6 +483,15 @@ def render(rec: dict) -> str:
             h = len(pts) // 2   # the upper half, as the text says
             k = fit_exponent([p[0] for p in pts][h:], [p[2] for p in pts][h:])
             parts.append(f"| {name} | {k:.2f} | {src[name]} |")
+        if d.get("fig530_orders"):
+            parts += ["", "Both orders alternately in the same run (`hsr_bench stack KIND N 5 [reverse]`, "
+                      "forward then reversed, 5 rounds; best of the rounds per order, median of the "
+                      "per-round ratios; docs/hsr.md, \"Fig. 5.30: the two insertion orders\", says why "
+                      "tri-steps reversed costs more):", "",
+                      "| scene | triangles | forward ms | reversed ms | reversed / forward |", "|---|---|---|---|---|"]
+            for r in d["fig530_orders"]:
+                parts.append(f"| {r['scene']} | {r['n']} | {r['forward'] * 1e3:.3f} | {r['reversed'] * 1e3:.3f} "
+                             f"| {r['ratio']:.2f} |")
         n, v, s = f530["teapot"][-1]
         parts += ["", f"Teapot speed ({n} triangles, {v} visible domains): **{1e6 * s / n:.0f} us per input "
                   f"triangle, {1e6 * s / v:.0f} us per visible domain** ({s:.2f} s for the whole scene). "

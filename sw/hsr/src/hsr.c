@@ -10,6 +10,18 @@
 
 typedef struct ivec { int *v; int n, cap; } ivec;
 
+/* -DHSR_STATS (off by default; docs/hsr.md, "Fig. 5.30"): counts of what the adds
+ * do, summed and printed to stderr by hsr_destroy (then reset).  Without it the
+ * counters compile to nothing (the object code is the same as without them). */
+#ifdef HSR_STATS
+#include <stdio.h>
+static struct { long long adds, cand, ext_miss, apart, overlay, no_both, hidden_inplace, covered, replaced,
+                edges_rem, edges_n, list_steps; } hst;
+#define HST_ADD(f, v) (hst.f += (v))
+#else
+#define HST_ADD(f, v) ((void)0)
+#endif
+
 static int iv_push(ivec *a, int x)
 {
     if (a->n == a->cap) {
@@ -21,12 +33,18 @@ static int iv_push(ivec *a, int x)
     a->v[a->n++] = x;
     return 1;
 }
-static int iv_find(const ivec *a, int x) { for (int i = 0; i < a->n; i++) if (a->v[i] == x) return i; return -1; }
+static int iv_find(const ivec *a, int x)
+{
+    for (int i = 0; i < a->n; i++) if (a->v[i] == x) { HST_ADD(list_steps, i + 1); return i; }
+    HST_ADD(list_steps, a->n);
+    return -1;
+}
 static int iv_add(ivec *a, int x) { return iv_find(a, x) >= 0 || iv_push(a, x); }
 static void iv_del(ivec *a, int x)
 {
     int i = iv_find(a, x);
     if (i < 0) return;
+    HST_ADD(list_steps, a->n - i - 1);
     memmove(a->v + i, a->v + i + 1, sizeof(int) * (size_t)(a->n - i - 1));
     a->n--;
 }
@@ -74,6 +92,13 @@ hsr_status hsr_create(const hsr_config *cfg, hsr_ctx **out)
 void hsr_destroy(hsr_ctx *h)
 {
     if (!h) return;
+#ifdef HSR_STATS
+    fprintf(stderr, "hsr_stats adds %lld candidates %lld extent_miss %lld apart %lld overlays %lld "
+            "no_overlap %lld hidden_in_place %lld covered %lld replaced %lld edges_rem %lld edges_n %lld "
+            "list_steps %lld\n", hst.adds, hst.cand, hst.ext_miss, hst.apart, hst.overlay, hst.no_both,
+            hst.hidden_inplace, hst.covered, hst.replaced, hst.edges_rem, hst.edges_n, hst.list_steps);
+    memset(&hst, 0, sizeof hst);
+#endif
     for (int i = 0; i < h->nm; i++) {
         hsr_domain_free(h->m[i].dom); free(h->m[i].vis.v); free(h->m[i].invis.v);
     }
@@ -248,13 +273,19 @@ static hsr_status add_domain(hsr_ctx *h, int id)
     unsigned acc_mark = next_stamp(h);
     int keep = -1;   /* a slot wholly covered by I, reused for I's new domain */
     hsr_gridlist_query(h->grid, rem->ext, collect, &cand);
+    HST_ADD(adds, 1); HST_ADD(cand, cand.n);
     for (int ci = 0; ci < cand.n && !hsr_domain_is_empty(rem); ci++) {
         int s = cand.v[ci];
         prefetch_cand(h, &cand, ci);
         llr *N = &h->l[s];
-        if (!N->used || !hsr_extent_overlap(rem->ext, N->dom->ext)) continue;
-        /* interiors shown disjoint: the overlay would meet nothing (saw_both 0) */
-        if (dom_interiors_apart(rem, N->dom)) continue;
+        if (!N->used || !hsr_extent_overlap(rem->ext, N->dom->ext)) { HST_ADD(ext_miss, 1); continue; }
+        /* interiors shown disjoint: the overlay would meet nothing (saw_both 0).
+         * -DHSR_NO_SEPARATION_TEST (an experiment, docs/hsr.md "Fig. 5.30") leaves it
+         * out, as the source's loop had no such test; results are the same. */
+#ifndef HSR_NO_SEPARATION_TEST
+        if (dom_interiors_apart(rem, N->dom)) { HST_ADD(apart, 1); continue; }
+#endif
+        HST_ADD(overlay, 1); HST_ADD(edges_rem, rem->n); HST_ADD(edges_n, N->dom->n);
         add_ctx c;   /* not cleared whole (60 orders, 4 KB): ord[j < k] is set below */
         c.saw_both = c.hidden = c.covered = 0;
         c.h = h; c.id = id; c.k = N->nvis; c.pre = N->par.v;
@@ -278,7 +309,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
         int cnt[HSR_MAX_PREFIX + 3];
         st = sweep_overlay_pieces(in, nin, hy, hb, nh, classify_add, &c, nlab, cnt);
         if (st != HSR_OK) goto done;
-        if (!c.saw_both) continue;   /* nothing assembled */
+        if (!c.saw_both) { HST_ADD(no_both, 1); continue; }   /* nothing assembled */
         /* which results are used (a label with no pieces is an empty domain) */
         int split = c.covered, front = 0;
         for (int pos = 0; pos <= c.k; pos++) front |= cnt[2 + pos] > 0;
@@ -296,6 +327,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
              * place.  Destroying and recreating N would copy its whole parent list on
              * every add, making n domains hidden behind one front domain cost O(n^2)
              * each (Fig. 5.30 tri-spets must be linear). */
+            HST_ADD(hidden_inplace, 1);
             for (int i = 1; i < nlab; i++) hsr_domain_free(res[i]);
             /* A re-add during damage repair may meet an N that already lists id; look
              * in id's own lists (short), not in N's (long). */
@@ -310,6 +342,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
              * slot with the longest parent list for the new domain instead of
              * copying that list (Fig. 5.30 tri-spets reversed: every new triangle
              * covers the one domain holding all earlier ones, O(n) per add). */
+            HST_ADD(covered, 1);
             for (int i = 1; i < nlab; i++) hsr_domain_free(res[i]);
             if (keep >= 0 && h->l[keep].par.n >= N->par.n) { st = absorb(h, s, &acc, acc_mark); }
             else { if (keep >= 0) st = absorb(h, keep, &acc, acc_mark); keep = s; }
@@ -317,6 +350,7 @@ static hsr_status add_domain(hsr_ctx *h, int id)
             continue;
         }
         /* N is replaced by its pieces; copy its parents first */
+        HST_ADD(replaced, 1);
         int pre[HSR_MAX_PREFIX + 1], k = c.k;
         memcpy(pre, N->par.v, sizeof(int) * (size_t)k);
         tail.n = 0;
