@@ -1,7 +1,7 @@
 // Difference Engine: one x-processor (PE) of the linear systolic array.
 //
 // Micro-architecture: docs/xproc.md. Instruction set: docs/isa.md (normative).
-// Cycle-level reference: sw/diffengine/structural.py (same register names; the
+// Cycle-level reference: sw/diffengine/model/structural.py (same register names; the
 // testbench tb/de_pe compares every register of every PE every cycle).
 //
 // Skew: a slot's identifier and data block 0 arrive together in cycle t ("stage 0");
@@ -399,7 +399,7 @@ module de_pe
   assign pix_valid_o = pixv_q;
   assign pix_o       = pix_q;
 
-  // Layout = DBG_FIELDS in sw/diffengine/structural.py, MSB first.
+  // Layout = DBG_FIELDS in sw/diffengine/model/structural.py, MSB first.
   assign dbg_o = {a_q, b_q, c_q, d_q,
                   pa_q, pb_q, pc_q, dis_q, lock_q, accm_q, act_q,
                   id_q, id2_q, out_q,

@@ -1,7 +1,7 @@
 // Testbench wrapper: N de_pe in a chain behind the input skew, every PE's state exposed.
 //
 // The driver feeds one instruction per clock in unskewed form (id + 36-bit data, like
-// sw/diffengine/structural.py Array.step); the skew registers here delay block 1 by one
+// sw/diffengine/model/structural.py Array.step); the skew registers here delay block 1 by one
 // and block 2 by two cycles, as the array top's input skew will.
 
 module de_pe_chain

@@ -1,7 +1,6 @@
-/* poly.c - how an OBJ polygon becomes triangles.  The same rule, with the
- * same arithmetic in the same order, is in sw/diffengine/reference.py
- * (_triangulate), so both readers cut a quad or n-gon the same way
- * (docs/hsr.md, "Polygons"). */
+/* poly.c - how an OBJ polygon becomes triangles.  The faces it makes are what
+ * `yproc read` hands the Python reference renderer (the project's one reader;
+ * docs/hsr.md, "Polygons" and "hsr-scene-1"). */
 #include <math.h>
 #include "internal.h"
 
