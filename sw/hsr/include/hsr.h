@@ -129,6 +129,20 @@ hsr_status hsr_remove(hsr_ctx *h, int id);
 hsr_status hsr_move(hsr_ctx *h, int id, const int64_t *xy,
                     const int *ring_len, int nrings, hsr_plane plane);
 hsr_status hsr_set_opacity(hsr_ctx *h, int id, double opacity);
+/* Several changes as one (an object's faces dragged, a material's opacity):
+ * the changed domains leave the LLR together, the damage is repaired once, then
+ * they are added back with their new geometry and opacity.  xy == NULL keeps a
+ * domain and its plane; opacity < 0 keeps the opacity.  The same result as the
+ * changes one by one (hsr_move, hsr_set_opacity), cheaper.  Every id must be
+ * present (HSR_ENOTFOUND) and listed once (HSR_EINVAL); nothing changes on an
+ * argument error. */
+typedef struct hsr_change {
+    int id;
+    const int64_t *xy; const int *ring_len; int nrings;   /* as hsr_move */
+    hsr_plane plane;
+    double opacity;
+} hsr_change;
+hsr_status hsr_change_many(hsr_ctx *h, const hsr_change *c, int n);
 /* Discard the LLR and re-add every MLR domain in id order. */
 hsr_status hsr_rebuild(hsr_ctx *h);
 

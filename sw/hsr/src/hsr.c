@@ -16,7 +16,7 @@ typedef struct ivec { int *v; int n, cap; } ivec;
 #ifdef HSR_STATS
 #include <stdio.h>
 static struct { long long adds, cand, ext_miss, apart, overlay, no_both, hidden_inplace, covered, replaced,
-                edges_rem, edges_n, list_steps; } hst;
+                edges_rem, edges_n, list_steps, repairs, holes, hole_edges, readds, merges; } hst;
 #define HST_ADD(f, v) (hst.f += (v))
 #else
 #define HST_ADD(f, v) ((void)0)
@@ -62,6 +62,7 @@ struct hsr_ctx {
     llr *l; int nl, capl;
     ivec freel;
     unsigned stamp;
+    ivec *track;   /* during a damage repair: the slots given a new domain (for merge_slots) */
 };
 
 static unsigned next_stamp(hsr_ctx *h)
@@ -95,8 +96,10 @@ void hsr_destroy(hsr_ctx *h)
 #ifdef HSR_STATS
     fprintf(stderr, "hsr_stats adds %lld candidates %lld extent_miss %lld apart %lld overlays %lld "
             "no_overlap %lld hidden_in_place %lld covered %lld replaced %lld edges_rem %lld edges_n %lld "
-            "list_steps %lld\n", hst.adds, hst.cand, hst.ext_miss, hst.apart, hst.overlay, hst.no_both,
-            hst.hidden_inplace, hst.covered, hst.replaced, hst.edges_rem, hst.edges_n, hst.list_steps);
+            "list_steps %lld repairs %lld hole_domains %lld hole_edges %lld readds %lld merges %lld\n",
+            hst.adds, hst.cand, hst.ext_miss, hst.apart, hst.overlay, hst.no_both,
+            hst.hidden_inplace, hst.covered, hst.replaced, hst.edges_rem, hst.edges_n, hst.list_steps,
+            hst.repairs, hst.holes, hst.hole_edges, hst.readds, hst.merges);
     memset(&hst, 0, sizeof hst);
 #endif
     for (int i = 0; i < h->nm; i++) {
@@ -138,7 +141,7 @@ static hsr_status llr_create(hsr_ctx *h, hsr_domain *dom, const int *pre, int np
         h->m[t].mark_par = mark;
         ok = iv_push(&L->par, t) && iv_add(&h->m[t].invis, s);
     }
-    if (!ok) return HSR_ENOMEM;
+    if (!ok || (h->track && !iv_push(h->track, s))) return HSR_ENOMEM;
     return hsr_gridlist_insert(h->grid, s, dom->ext);
 }
 
@@ -232,6 +235,7 @@ static hsr_status adopt(hsr_ctx *h, int s, int id, hsr_domain *dom, const ivec *
         if (p == id || !h->m[p].present || iv_find(&h->m[p].invis, s) >= 0 || iv_find(&h->m[p].vis, s) >= 0) continue;
         if (!iv_push(&L->par, p) || !iv_push(&h->m[p].invis, s)) st = HSR_ENOMEM;
     }
+    if (h->track && !iv_push(h->track, s)) st = HSR_ENOMEM;
     hsr_status s2 = hsr_gridlist_insert(h->grid, s, dom->ext);
     return st != HSR_OK ? st : s2;
 }
@@ -262,14 +266,15 @@ static inline __attribute__((always_inline)) void prefetch_cand(const hsr_ctx *h
     }
 }
 
-static hsr_status add_domain(hsr_ctx *h, int id)
+/* Adds the part rem (owned, taken) of MLR domain id to the LLR: all of it for
+ * an add, its part in the damaged region for a damage repair.  The depth
+ * orders are those of id's whole domain, so a part is added as in a full build. */
+static hsr_status add_region(hsr_ctx *h, int id, hsr_domain *rem)
 {
     hsr_status st = HSR_OK;
     mlr *M = &h->m[id];
-    if (hsr_domain_is_empty(M->dom)) return HSR_OK;
-    hsr_domain *rem = hsr_domain_clone(M->dom);
+    if (hsr_domain_is_empty(rem)) { hsr_domain_free(rem); return HSR_OK; }
     ivec cand = {0, 0, 0}, acc = {0, 0, 0}, tail = {0, 0, 0};
-    if (!rem) return HSR_ENOMEM;
     unsigned acc_mark = next_stamp(h);
     int keep = -1;   /* a slot wholly covered by I, reused for I's new domain */
     hsr_gridlist_query(h->grid, rem->ext, collect, &cand);
@@ -387,56 +392,159 @@ done:
     return st;
 }
 
+static hsr_status add_domain(hsr_ctx *h, int id)
+{
+    if (hsr_domain_is_empty(h->m[id].dom)) return HSR_OK;
+    hsr_domain *rem = hsr_domain_clone(h->m[id].dom);
+    return rem ? add_region(h, id, rem) : HSR_ENOMEM;
+}
+
 /* ---- removal with damage repair (5.4.5) --------------------------- */
-static hsr_status remove_domain(hsr_ctx *h, int X, ivec *R)
+/* Removing MLR domains leaves a hole in the LLR: the LLR domains with one of
+ * them in their visible prefix (where they are hidden parents they are just
+ * dropped from the list).  Whatever shows in the hole is among the parents of
+ * the hole's domains (every MLR domain that covers an LLR domain is one of its
+ * parents), so the repair re-adds each of those parents clipped to the hole, in
+ * id order, with the depth orders of its whole domain (add_region), and then
+ * joins each new domain to the LLR domains with the same visible prefix whose
+ * extents it meets (merge_slots), so that repeated moves do not cut the LLR up
+ * along every old hole.  The work is in proportion to the hole and its parents,
+ * not to the parents' whole domains (docs/hsr.md, "Damage repair"). */
+static int cmp_int(const void *a, const void *b) { return *(const int *)a - *(const int *)b; }
+
+static int classify_hole(uint64_t db, uint64_t cb, void *ctx)
+{
+    (void)cb; (void)ctx;
+    return (db & 1) ? 0 : -1;
+}
+
+/* Takes xs[0..nx-1] out of the LLR: R receives the parents to re-add (sorted,
+ * without xs), *hole the union of the removed LLR domains (NULL if none). */
+static hsr_status damage_remove(hsr_ctx *h, const int *xs, int nx, ivec *R, hsr_domain **hole)
 {
     ivec L = {0, 0, 0};
-    char *inL = calloc((size_t)h->nl + 1, 1), *inR = calloc((size_t)h->nm + 1, 1);
+    sweep_in *in = NULL;
     hsr_status st = HSR_ENOMEM;
-    if (!inL || !inR) goto done;
-    for (int i = 0; i < h->m[X].vis.n; i++) {
-        int s = h->m[X].vis.v[i];
-        if (!inL[s]) { inL[s] = 1; if (!iv_push(&L, s)) goto done; }
+    *hole = NULL;
+    unsigned mark = next_stamp(h);
+    for (int i = 0; i < nx; i++) h->m[xs[i]].mark_acc = mark;
+    for (int i = 0; i < nx; i++) {
+        mlr *X = &h->m[xs[i]];
+        for (int j = 0; j < X->vis.n; j++) if (!iv_push(&L, X->vis.v[j])) goto done;
+        for (int j = X->invis.n - 1; j >= 0; j--) iv_del(&h->l[X->invis.v[j]].par, xs[i]);
+        X->invis.n = 0;
     }
-    for (int il = 0, ir = 0; il < L.n || ir < R->n;) {
-        while (il < L.n) {
-            const llr *N = &h->l[L.v[il++]];
-            for (int i = 0; i < N->par.n; i++) {
-                int p = N->par.v[i];
-                if (p != X && !inR[p]) { inR[p] = 1; if (!iv_push(R, p)) goto done; }
-            }
-        }
-        while (ir < R->n) {
-            const mlr *P = &h->m[R->v[ir++]];
-            for (int i = 0; i < P->vis.n; i++) {
-                int s = P->vis.v[i];
-                if (!inL[s]) { inL[s] = 1; if (!iv_push(&L, s)) goto done; }
-            }
+    if (L.n > 1) {
+        qsort(L.v, (size_t)L.n, sizeof(int), cmp_int);
+        int w = 1;
+        for (int i = 1; i < L.n; i++) if (L.v[i] != L.v[w - 1]) L.v[w++] = L.v[i];
+        L.n = w;
+    }
+    for (int i = 0; i < L.n; i++) {
+        const llr *N = &h->l[L.v[i]];
+        for (int j = 0; j < N->par.n; j++) {
+            int p = N->par.v[j];
+            if (h->m[p].mark_acc == mark) continue;
+            h->m[p].mark_acc = mark;
+            if (!iv_push(R, p)) goto done;
         }
     }
-    while (h->m[X].invis.n) {   /* X was hidden there: just drop it */
-        int s = h->m[X].invis.v[0];
-        if (inL[s]) { iv_del(&h->m[X].invis, s); continue; }
-        iv_del(&h->l[s].par, X);
-        iv_del(&h->m[X].invis, s);
+    if (R->n > 1) qsort(R->v, (size_t)R->n, sizeof(int), cmp_int);
+    if (L.n) {
+        if (!(in = malloc(sizeof(sweep_in) * (size_t)L.n))) goto done;
+        for (int i = 0; i < L.n; i++) in[i] = (sweep_in){h->l[L.v[i]].dom->e, h->l[L.v[i]].dom->n, 0};
+        st = sweep_overlay(in, L.n, NULL, NULL, 0, classify_hole, NULL, 1, hole);
+        if (st != HSR_OK) goto done;
+        HST_ADD(holes, L.n); HST_ADD(hole_edges, (*hole)->n);
     }
     for (int i = 0; i < L.n; i++) llr_destroy(h, L.v[i]);
     st = HSR_OK;
 done:
-    free(L.v); free(inL); free(inR);
+    free(L.v); free(in);
     return st;
 }
 
-static int cmp_int(const void *a, const void *b) { return *(const int *)a - *(const int *)b; }
-
-static hsr_status readd(hsr_ctx *h, ivec *R)
+static int same_prefix(const llr *a, const llr *b)
 {
-    if (R->n > 1) qsort(R->v, (size_t)R->n, sizeof(int), cmp_int);
-    for (int i = 0; i < R->n; i++) {
-        hsr_status st = add_domain(h, R->v[i]);
-        if (st != HSR_OK) return st;
+    return a->nvis == b->nvis && !memcmp(a->par.v, b->par.v, sizeof(int) * (size_t)a->nvis);
+}
+
+/* Slot k takes the union u of its domain and slot d's (same prefix): d's hidden
+ * parents that k lacks are appended (looked up in the parent's own list), d goes. */
+static hsr_status join(hsr_ctx *h, int k, int d, hsr_domain *u)
+{
+    hsr_status st = HSR_OK;
+    const llr *D = &h->l[d];
+    for (int i = D->nvis; i < D->par.n && st == HSR_OK; i++) {
+        int p = D->par.v[i];
+        if (iv_find(&h->m[p].invis, k) >= 0) continue;
+        if (!iv_push(&h->l[k].par, p) || !iv_push(&h->m[p].invis, k)) st = HSR_ENOMEM;
     }
-    return HSR_OK;
+    llr_destroy(h, d);
+    llr *K = &h->l[k];
+    hsr_gridlist_remove(h->grid, k);
+    hsr_domain_free(K->dom);
+    K->dom = u;
+    hsr_status s2 = hsr_gridlist_insert(h->grid, k, u->ext);
+    HST_ADD(merges, 1);
+    return st != HSR_OK ? st : s2;
+}
+
+/* Each slot in track still in use is joined with every LLR domain of the same
+ * visible prefix whose extent meets its own (the slot keeping the longer parent
+ * list keeps the union). */
+static hsr_status merge_slots(hsr_ctx *h, const ivec *track)
+{
+    hsr_status st = HSR_OK;
+    ivec cand = {0, 0, 0};
+    for (int ti = 0; ti < track->n && st == HSR_OK; ti++) {
+        int s = track->v[ti];
+        if (!h->l[s].used) continue;
+        int again = 1;
+        while (again && st == HSR_OK) {
+            again = 0;
+            cand.n = 0;
+            hsr_gridlist_query(h->grid, h->l[s].dom->ext, collect, &cand);
+            for (int ci = 0; ci < cand.n; ci++) {
+                int t = cand.v[ci];
+                const llr *S = &h->l[s], *T = &h->l[t];
+                if (t == s || !T->used || !same_prefix(S, T) || !hsr_extent_overlap(S->dom->ext, T->dom->ext)) continue;
+                hsr_domain *u = NULL;
+                st = hsr_domain_boolean(S->dom, T->dom, HSR_UNION, &u);
+                if (st != HSR_OK) break;
+                int k = T->par.n > S->par.n ? t : s;
+                st = join(h, k, k == s ? t : s, u);
+                s = k; again = 1;
+                break;
+            }
+        }
+    }
+    free(cand.v);
+    return st;
+}
+
+/* Removes xs[0..nx-1] (marked not present by the caller) from the LLR and
+ * repairs the damage. */
+static hsr_status repair(hsr_ctx *h, const int *xs, int nx)
+{
+    ivec R = {0, 0, 0}, track = {0, 0, 0};
+    hsr_domain *hole = NULL;
+    HST_ADD(repairs, 1);
+    hsr_status st = damage_remove(h, xs, nx, &R, &hole);
+    h->track = &track;
+    for (int i = 0; i < R.n && st == HSR_OK && hole; i++) {
+        const mlr *P = &h->m[R.v[i]];
+        if (!hsr_extent_overlap(P->dom->ext, hole->ext)) continue;
+        hsr_domain *rem = NULL;
+        st = hsr_domain_boolean(P->dom, hole, HSR_INTERSECT, &rem);
+        HST_ADD(readds, 1);
+        if (st == HSR_OK) st = add_region(h, R.v[i], rem);
+    }
+    h->track = NULL;
+    if (st == HSR_OK) st = merge_slots(h, &track);
+    hsr_domain_free(hole);
+    free(R.v); free(track.v);
+    return st;
 }
 
 /* ---- public operations --------------------------------------------- */
@@ -466,28 +574,51 @@ hsr_status hsr_add(hsr_ctx *h, const int64_t *xy, const int *ring_len, int nring
 hsr_status hsr_remove(hsr_ctx *h, int id)
 {
     if (!id_ok(h, id)) return HSR_ENOTFOUND;
-    ivec R = {0, 0, 0};
-    hsr_status st = remove_domain(h, id, &R);
     h->m[id].present = 0;
+    hsr_status st = repair(h, &id, 1);
     hsr_domain_free(h->m[id].dom);
     h->m[id].dom = NULL;
-    if (st == HSR_OK) st = readd(h, &R);
-    free(R.v);
     return st;
 }
 
-static hsr_status change(hsr_ctx *h, int id, hsr_domain *nd, const hsr_plane *np, double op)
+hsr_status hsr_change_many(hsr_ctx *h, const hsr_change *c, int n)
 {
-    ivec R = {0, 0, 0};
-    hsr_status st = remove_domain(h, id, &R);
-    h->m[id].present = 0;
-    if (st == HSR_OK) st = readd(h, &R);
-    free(R.v);
-    h->m[id].present = 1;
-    if (nd) { hsr_domain_free(h->m[id].dom); h->m[id].dom = nd; }
-    if (np) h->m[id].plane = *np;
-    if (op >= 0) h->m[id].opacity = op;
-    if (st == HSR_OK) st = add_domain(h, id);
+    if (!h || n < 0 || (n > 0 && !c)) return HSR_EINVAL;
+    unsigned mark = next_stamp(h);
+    for (int i = 0; i < n; i++) {
+        if (!id_ok(h, c[i].id)) return HSR_ENOTFOUND;
+        if (h->m[c[i].id].mark_par == mark) return HSR_EINVAL;   /* listed twice */
+        h->m[c[i].id].mark_par = mark;
+        if (c[i].xy && !plane_ok(c[i].plane)) return HSR_EINVAL;
+        if (!(c[i].opacity < 0 || c[i].opacity <= 1.0)) return HSR_EINVAL;   /* NaN too */
+    }
+    hsr_domain **nd = calloc((size_t)n + 1, sizeof *nd);
+    int *xs = malloc(sizeof(int) * ((size_t)n + 1)), nx = 0;
+    hsr_status st = nd && xs ? HSR_OK : HSR_ENOMEM;
+    for (int i = 0; i < n && st == HSR_OK; i++)
+        if (c[i].xy) st = hsr_domain_from_rings(c[i].xy, c[i].ring_len, c[i].nrings, &nd[i]);
+    /* Only whether a domain is opaque shapes the LLR: a transparent domain that
+     * stays transparent keeps its place in every prefix (the composited colour is
+     * the caller's), so it needs no repair. */
+    for (int i = 0; i < n && st == HSR_OK; i++) {
+        const mlr *M = &h->m[c[i].id];
+        int keep = !nd[i] && (c[i].opacity < 0 || (M->opacity < 1.0 && c[i].opacity < 1.0));
+        if (!keep) xs[nx++] = c[i].id;
+    }
+    if (st == HSR_OK) {
+        if (nx > 1) qsort(xs, (size_t)nx, sizeof(int), cmp_int);
+        for (int i = 0; i < nx; i++) h->m[xs[i]].present = 0;
+        st = repair(h, xs, nx);
+        for (int i = 0; i < nx; i++) h->m[xs[i]].present = 1;
+        for (int i = 0; i < n; i++) {
+            mlr *M = &h->m[c[i].id];
+            if (nd[i]) { hsr_domain_free(M->dom); M->dom = nd[i]; nd[i] = NULL; M->plane = c[i].plane; }
+            if (c[i].opacity >= 0) M->opacity = c[i].opacity;
+        }
+        for (int i = 0; i < nx && st == HSR_OK; i++) st = add_domain(h, xs[i]);
+    }
+    for (int i = 0; i < n && nd; i++) hsr_domain_free(nd[i]);
+    free(nd); free(xs);
     return st;
 }
 
@@ -495,18 +626,17 @@ hsr_status hsr_move(hsr_ctx *h, int id, const int64_t *xy, const int *ring_len,
                     int nrings, hsr_plane plane)
 {
     if (!id_ok(h, id)) return HSR_ENOTFOUND;
-    if (!plane_ok(plane)) return HSR_EINVAL;
-    hsr_domain *d;
-    hsr_status st = hsr_domain_from_rings(xy, ring_len, nrings, &d);
-    if (st != HSR_OK) return st;
-    return change(h, id, d, &plane, -1);
+    if (!plane_ok(plane) || !xy) return HSR_EINVAL;
+    hsr_change c = {id, xy, ring_len, nrings, plane, -1};
+    return hsr_change_many(h, &c, 1);
 }
 
 hsr_status hsr_set_opacity(hsr_ctx *h, int id, double opacity)
 {
     if (!id_ok(h, id)) return HSR_ENOTFOUND;
     if (!(opacity >= 0.0 && opacity <= 1.0)) return HSR_EINVAL;
-    return change(h, id, NULL, NULL, opacity);
+    hsr_change c = {id, NULL, NULL, 0, {0, 0, 0}, opacity};
+    return hsr_change_many(h, &c, 1);
 }
 
 hsr_status hsr_rebuild(hsr_ctx *h)
