@@ -187,27 +187,35 @@ hsr_status yp_anim_apply(yp_anim *a, int fr, hsr_ctx *h, yp_shader *sh, int *y0,
         for (int k = 0; k < 3; k++) if (sc->lights[l].dir[k] != old_l[l].dir[k]) lights = 1;
     if (sh) st = yp_shader_update(sh, sc);
     if (h && st == HSR_OK) {
+        /* every moved face and changed opacity of the frame in one hsr_change_many:
+         * one damage repair for all of them (docs/hsr.md, "Damage repair") */
         hsr_view vw;
         if (!hsr_view_make(sc, &vw)) st = HSR_EINVAL;
-        int cap = hsr_face_cap(sc);
+        int cap = hsr_face_cap(sc), nc = 0, nq = 0;
+        for (int fi = 0; fi < sc->nf; fi++) nq += moved[sc->f[fi].obj];
         double *ba = malloc(sizeof(double) * 3 * (size_t)cap), *bb = malloc(sizeof(double) * 3 * (size_t)cap);
-        int64_t *q = malloc(sizeof(int64_t) * 2 * (size_t)cap);
-        if (!ba || !bb || !q) st = HSR_ENOMEM;
-        for (int fi = 0; fi < sc->nf && st == HSR_OK; fi++) {
-            int m = sc->f[fi].material;
-            if (moved[sc->f[fi].obj]) {
-                extent_rows(h, fi, H, &ly0, &ly1);
-                hsr_plane pl;
-                int len = hsr_face_project(sc, &vw, fi, ba, bb, q, &pl);
-                st = hsr_move(h, fi, q, &len, 1, pl);
-                extent_rows(h, fi, H, &ly0, &ly1);
-            }
-            if (st == HSR_OK && sc->mat[m].opacity != old_op[m]) {
-                st = hsr_set_opacity(h, fi, sc->mat[m].opacity);
-                extent_rows(h, fi, H, &ly0, &ly1);
+        int64_t *q = malloc(sizeof(int64_t) * 2 * (size_t)cap * (size_t)(nq + 1));
+        int *len = malloc(sizeof(int) * (size_t)(nq + 1));
+        hsr_change *chg = malloc(sizeof(hsr_change) * (size_t)(sc->nf + 1));
+        if (!ba || !bb || !q || !len || !chg) st = HSR_ENOMEM;
+        for (int fi = 0, k = 0; fi < sc->nf && st == HSR_OK; fi++) {
+            int m = sc->f[fi].material, mv = moved[sc->f[fi].obj], op = sc->mat[m].opacity != old_op[m];
+            if (!mv && !op) continue;
+            hsr_change *c = &chg[nc++];
+            c->id = fi; c->xy = NULL; c->ring_len = NULL; c->nrings = 0;
+            c->plane = (hsr_plane){0, 0, 0};
+            c->opacity = op ? sc->mat[m].opacity : -1;
+            extent_rows(h, fi, H, &ly0, &ly1);
+            if (mv) {
+                int64_t *qk = q + 2 * (size_t)cap * (size_t)k;
+                len[k] = hsr_face_project(sc, &vw, fi, ba, bb, qk, &c->plane);
+                c->xy = qk; c->ring_len = &len[k]; c->nrings = 1;
+                k++;
             }
         }
-        free(ba); free(bb); free(q);
+        if (st == HSR_OK && nc) st = hsr_change_many(h, chg, nc);
+        for (int i = 0; i < nc && st == HSR_OK; i++) extent_rows(h, chg[i].id, H, &ly0, &ly1);
+        free(ba); free(bb); free(q); free(len); free(chg);
     }
     if (lights) { ly0 = 0; ly1 = H; }
     if (ly0 > ly1) ly0 = ly1 = 0;
