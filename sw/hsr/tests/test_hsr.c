@@ -1,6 +1,7 @@
 /* test_hsr.c - incremental HSR: add, remove (damage repair), move,
  * transparency, pick. */
 #include <stdlib.h>
+#include <string.h>
 #include "t.h"
 
 hsr_ctx *t_ctx(void)
@@ -214,6 +215,136 @@ static void test_hsr_bad_arguments(void)
     hsr_destroy(h);
 }
 
+/* a fresh context with the MLR domains of h (same ids, planes, opacities) */
+static hsr_ctx *rebuilt_copy(const hsr_ctx *h)
+{
+    hsr_ctx *g = t_ctx();
+    for (int id = 0; id < hsr_mlr_slots(h); id++) {
+        const hsr_domain *d; hsr_plane p; double op;
+        CHECK(hsr_mlr_get(h, id, &d, &p, &op, NULL, NULL));
+        double *xy; int *len, nr, tot = 0;
+        CHECK(hsr_domain_rings(d, &xy, &len, &nr) == HSR_OK);
+        for (int i = 0; i < nr; i++) tot += len[i];
+        int64_t *q = malloc(sizeof(int64_t) * 2 * (size_t)(tot + 1));
+        for (int i = 0; i < 2 * tot; i++) q[i] = llround(xy[i]);
+        int nid = -1, zero = 0;
+        CHECK(hsr_add(g, q, nr ? len : &zero, nr ? nr : 1, p, op, &nid) == HSR_OK && nid == id);
+        free(q); free(xy); free(len);
+    }
+    return g;
+}
+
+static void same_visibility(const hsr_ctx *h, const hsr_ctx *g)
+{
+    CHECK(hsr_check(h) == HSR_OK);
+    for (int id = 0; id < hsr_mlr_slots(h); id++) CHECK_NEAR(t_visible_area(h, id), t_visible_area(g, id), 1e-12);
+    CHECK_NEAR(t_llr_total_area(h), t_llr_total_area(g), 1e-12);
+}
+
+/* A three-face part dragged in 24 steps across a wall of 20 overlapping rectangles
+ * (hsr_change_many, one repair a step) and back by one hsr_move per face: every step
+ * shows what a full build shows, and joining same-prefix domains after each repair
+ * keeps the LLR from being cut up along the old holes. */
+static void test_hsr_drag_equals_build_and_stays_compact(void)
+{
+    hsr_ctx *h = t_ctx();
+    for (int i = 0; i < 20; i++) {
+        int64_t l = 40 * (i % 5), b = 50 * (i / 5);
+        CHECK(t_add_rect(h, l, b, l + 70, b + 80, 0.01 * (i % 3), 10 + i, i % 4 == 3 ? 0.5 : 1) == i);
+    }
+    int part[3];
+    part[0] = t_add_rect(h, 0, 0, 30, 30, 0, 1, 1);
+    part[1] = t_add_rect(h, 10, 10, 40, 25, 0, 2, 0.5);
+    part[2] = t_add_rect(h, 5, 20, 25, 45, 0.02, 0, 1);
+    hsr_ctx *g = rebuilt_copy(h);
+    int built = 0;
+    for (int s = 0; s < hsr_llr_slots(g); s++) built += hsr_llr_get(g, s, NULL, NULL, NULL, NULL);
+    hsr_destroy(g);
+    for (int back = 0; back < 2; back++)
+        for (int step = 1; step <= 24; step++) {
+            int64_t dx = back ? -7 : 7, dy = back ? -5 : 5;
+            hsr_change c[3];
+            int64_t xy[3][8];
+            int n4 = 4;
+            for (int k = 0; k < 3; k++) {
+                const hsr_domain *d; hsr_plane p;
+                CHECK(hsr_mlr_get(h, part[k], &d, &p, NULL, NULL, NULL));
+                hsr_extent e = hsr_domain_extent(d);
+                int64_t r[8] = {e.left + dx, e.bot + dy, e.right + dx, e.bot + dy, e.right + dx, e.top + dy, e.left + dx, e.top + dy};
+                memcpy(xy[k], r, sizeof r);
+                p.c -= p.a * (double)dx;   /* the plane moves with the face */
+                c[k] = (hsr_change){part[k], xy[k], &n4, 1, p, -1};
+            }
+            if (!back) CHECK(hsr_change_many(h, c, 3) == HSR_OK);
+            else for (int k = 0; k < 3; k++) CHECK(hsr_move(h, c[k].id, c[k].xy, &n4, 1, c[k].plane) == HSR_OK);
+            g = rebuilt_copy(h);
+            same_visibility(h, g);
+            hsr_destroy(g);
+        }
+    /* back where it started: the same visibility as the first build, and the LLR no more
+     * than a quarter larger than that build's (without the joins it grows with every step) */
+    int now = llr_count(h);
+    printf("     LLR domains: first build %d, after 48 drag steps %d\n", built, now);
+    CHECK(now <= built + built / 4);
+    hsr_destroy(h);
+}
+
+static void test_hsr_change_many_bad_arguments_change_nothing(void)
+{
+    hsr_ctx *h = t_ctx();
+    int a = t_add_rect(h, 0, 0, 20, 20, 0, 1, 1), b = t_add_rect(h, 10, 10, 30, 30, 0, 0, 1);
+    int64_t xy[8] = {100, 100, 120, 100, 120, 120, 100, 120}, far[8] = {0, 0, HSR_COORD_MAX + 1, 0, 0, 5};
+    int n4 = 4, n3 = 3;
+    hsr_plane ok = {0, 0, 5}, nan = {NAN, 0, 0};
+    hsr_change twice[2] = {{a, xy, &n4, 1, ok, -1}, {a, NULL, NULL, 0, ok, 0.5}};
+    hsr_change c;
+    CHECK(hsr_change_many(h, twice, 2) == HSR_EINVAL);
+    c = (hsr_change){7, xy, &n4, 1, ok, -1};
+    CHECK(hsr_change_many(h, &c, 1) == HSR_ENOTFOUND);
+    c = (hsr_change){a, xy, &n4, 1, nan, -1};
+    CHECK(hsr_change_many(h, &c, 1) == HSR_EINVAL);
+    c = (hsr_change){a, NULL, NULL, 0, ok, 1.5};
+    CHECK(hsr_change_many(h, &c, 1) == HSR_EINVAL);
+    c = (hsr_change){a, NULL, NULL, 0, ok, NAN};
+    CHECK(hsr_change_many(h, &c, 1) == HSR_EINVAL);
+    c = (hsr_change){a, far, &n3, 1, ok, -1};
+    CHECK(hsr_change_many(h, &c, 1) == HSR_ERANGE);
+    CHECK(hsr_change_many(h, NULL, 1) == HSR_EINVAL && hsr_change_many(NULL, &c, 1) == HSR_EINVAL);
+    CHECK(hsr_change_many(h, NULL, 0) == HSR_OK);
+    CHECK_NEAR(t_visible_area(h, a), 300, 1e-12);
+    CHECK_NEAR(t_visible_area(h, b), 400, 1e-12);
+    CHECK(llr_count(h) == 2 && hsr_check(h) == HSR_OK);
+    hsr_destroy(h);
+}
+
+/* Only opaque or not shapes the LLR: a transparent domain's opacity changed to
+ * another transparent one keeps the LLR as it is; made opaque, it is repaired. */
+static void test_hsr_transparent_opacity_change_keeps_llr(void)
+{
+    hsr_ctx *h = t_ctx();
+    int o = t_add_rect(h, 0, 0, 20, 20, 0, 1, 1);
+    int t = t_add_rect(h, 10, 10, 30, 30, 0, 0, 0.5);
+    const hsr_domain *before[8] = {0};
+    int n = hsr_llr_slots(h);
+    CHECK(n <= 8);
+    for (int s = 0; s < n && s < 8; s++) hsr_llr_get(h, s, &before[s], NULL, NULL, NULL);
+    CHECK(hsr_set_opacity(h, t, 0.25) == HSR_OK && hsr_check(h) == HSR_OK);
+    CHECK(hsr_llr_slots(h) == n);
+    for (int s = 0; s < n && s < 8; s++) {
+        const hsr_domain *d = NULL;
+        hsr_llr_get(h, s, &d, NULL, NULL, NULL);
+        CHECK(d == before[s]);   /* untouched */
+    }
+    double op;
+    CHECK(hsr_mlr_get(h, t, NULL, NULL, &op, NULL, NULL) && op == 0.25);
+    CHECK(hsr_set_opacity(h, t, 1.0) == HSR_OK);
+    hsr_ctx *g = rebuilt_copy(h);
+    same_visibility(h, g);
+    CHECK_NEAR(t_visible_area(h, o), 300, 1e-12);
+    hsr_destroy(g);
+    hsr_destroy(h);
+}
+
 void suite_hsr(void)
 {
     RUN(test_hsr_two_opaque_overlap_any_order);
@@ -225,4 +356,7 @@ void suite_hsr(void)
     RUN(test_hsr_coincident_planes_lower_id_in_front);
     RUN(test_hsr_move_then_rebuild_identical);
     RUN(test_hsr_bad_arguments);
+    RUN(test_hsr_drag_equals_build_and_stays_compact);
+    RUN(test_hsr_change_many_bad_arguments_change_nothing);
+    RUN(test_hsr_transparent_opacity_change_keeps_llr);
 }

@@ -121,7 +121,9 @@ static void check_invariants(const hsr_ctx *h, unsigned long long seed)
     hsr_domain_free(ui); hsr_domain_free(ul); hsr_domain_free(x);
 }
 
-static void run_scene(unsigned long long seed, int n, int ops)
+/* many: a fifth kind of step, hsr_change_many of 2..5 distinct present ids (some
+ * moved, some given a new opacity, some both) */
+static void run_scene(unsigned long long seed, int n, int ops, int many)
 {
     unsigned long long s = seed;
     hsr_ctx *h = t_ctx();
@@ -134,9 +136,27 @@ static void run_scene(unsigned long long seed, int n, int ops)
     }
     check_invariants(h, seed);
     for (int k = 0; k < ops; k++) {
-        int id = (int)(t_rand(&s) % (unsigned)hsr_mlr_slots(h)), op = (int)(t_rand(&s) % 4);
+        int id = (int)(t_rand(&s) % (unsigned)hsr_mlr_slots(h)), op = (int)(t_rand(&s) % (many ? 5u : 4u));
         if (!hsr_mlr_get(h, id, NULL, NULL, NULL, NULL, NULL)) op = 3;
-        if (op == 0) CHECK(hsr_remove(h, id) == HSR_OK);
+        if (op == 4) {
+            hsr_change c[5];
+            int64_t cxy[5][12];
+            int clen[5], nc = 0, want = 2 + (int)(t_rand(&s) % 4);
+            for (int tries = 0; tries < 40 && nc < want; tries++) {
+                int j = (int)(t_rand(&s) % (unsigned)hsr_mlr_slots(h)), dup = 0;
+                for (int i = 0; i < nc; i++) dup |= c[i].id == j;
+                if (dup || !hsr_mlr_get(h, j, NULL, NULL, NULL, NULL, NULL)) continue;
+                int kind = (int)(t_rand(&s) % 3);   /* 0 move, 1 opacity, 2 both */
+                c[nc] = (hsr_change){j, NULL, NULL, 0, {0, 0, 0}, kind ? rand_opacity(&s) : -1};
+                if (kind != 1) {
+                    rand_poly(&s, cxy[nc], &clen[nc]);
+                    c[nc].xy = cxy[nc]; c[nc].ring_len = &clen[nc]; c[nc].nrings = 1;
+                    c[nc].plane = rand_plane(&s);
+                }
+                nc++;
+            }
+            CHECK(hsr_change_many(h, c, nc) == HSR_OK);
+        } else if (op == 0) CHECK(hsr_remove(h, id) == HSR_OK);
         else if (op == 1) {
             rand_poly(&s, xy, &len);
             CHECK(hsr_move(h, id, xy, &len, 1, rand_plane(&s)) == HSR_OK);
@@ -158,24 +178,37 @@ static void run_scene(unsigned long long seed, int n, int ops)
     hsr_destroy(h);
 }
 
+/* runs scenes base, base+1, ... (SEED=<n> replaces base): scene r has n0 + r * dn
+ * domains, then ops steps */
+static void run_seeds(const char *what, unsigned long long base, int runs, int n0, int dn, int ops, int many)
+{
+    if (getenv("SEED")) base = strtoull(getenv("SEED"), NULL, 10);
+    printf("     %s: base seed=%llu, %d scenes\n", what, base, runs);
+    for (int r = 0; r < runs && !t_failed_now; r++) run_scene(base + (unsigned long long)r, n0 + r * dn, ops, many);
+}
+
 static void test_random_scenes_disjoint_union_and_rebuild(void)
 {
-    unsigned long long base = 20240601;
-    if (getenv("SEED")) base = strtoull(getenv("SEED"), NULL, 10);
-    int runs = t_quick ? 4 : 20;
-    printf("     random scenes: base seed=%llu, %d scenes\n", base, runs);
-    for (int r = 0; r < runs && !t_failed_now; r++) run_scene(base + (unsigned long long)r, 25 + r * 2, 20);
+    run_seeds("random scenes", 20240601, t_quick ? 4 : 20, 25, 2, 20, 0);
 }
 
 static void test_random_dense_stack_incremental(void)
 {
     unsigned long long base = 4242;
     printf("     dense stack seed=%llu\n", base);
-    run_scene(base, t_quick ? 40 : 80, t_quick ? 20 : 60);
+    run_scene(base, t_quick ? 40 : 80, t_quick ? 20 : 60, 0);
+}
+
+/* the same with hsr_change_many among the steps, and longer sequences: the repairs
+ * of several changes at once and the joins after them, checked against a rebuild */
+static void test_random_scenes_change_many_equals_rebuild(void)
+{
+    run_seeds("change_many scenes", 19951126, t_quick ? 4 : 16, 30, 3, 60, 1);
 }
 
 void suite_props(void)
 {
     RUN(test_random_scenes_disjoint_union_and_rebuild);
     RUN(test_random_dense_stack_incremental);
+    RUN(test_random_scenes_change_many_equals_rebuild);
 }

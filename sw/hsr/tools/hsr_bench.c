@@ -22,10 +22,15 @@
  *   hsr_bench move SCENE_A SCENE_B K [REPEAT]
  *       SCENE_A and SCENE_B differ only in the last K faces (a small object
  *       moved).  Times the full build of A, hsr_rebuild of A, and the
- *       incremental move of those K faces to their B geometry (hsr_move per
- *       face) and back; checks after the move that every MLR id's visible
- *       area equals that of a full build of B (1e-9 relative) and that
- *       hsr_check passes.  Prints the times and "check ok" or the mismatch.
+ *       incremental move of those K faces (K <= 64) to their B geometry and
+ *       back, first with one hsr_move per face (move, move_back), then with
+ *       one hsr_change_many for all K (move_many, move_many_back); checks
+ *       after every move that every MLR id's visible area equals that of a
+ *       full build of B (and after every move back, of A; 1e-9 relative) and
+ *       that hsr_check passes.  Prints the best times of REPEAT rounds, the
+ *       visible domains of the builds of A and B, after the first
+ *       hsr_change_many (visible_moved) and after the last round's moves
+ *       (visible_cycled, before its rebuild), and "check ok" or the mismatch.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -239,16 +244,51 @@ static void areas(const hsr_ctx *h, double *a, int n)
     }
 }
 
+/* Moves faces n-K..n-1 to the geometry g: one hsr_move per face, or all in one
+ * hsr_change_many (many); returns the seconds, or -1 on failure. */
+static double move_faces(hsr_ctx *h, int n, int K, const geom *g, int many)
+{
+    double t0 = now();
+    if (many) {
+        hsr_change c[64];
+        for (int k = 0; k < K; k++)
+            c[k] = (hsr_change){n - K + k, g[k].xy, g[k].len, g[k].nr, g[k].pl, -1};
+        if (hsr_change_many(h, c, K) != HSR_OK) return -1;
+    } else {
+        for (int k = 0; k < K; k++)
+            if (hsr_move(h, n - K + k, g[k].xy, g[k].len, g[k].nr, g[k].pl) != HSR_OK) return -1;
+    }
+    return now() - t0;
+}
+
+/* 1 if every MLR id's visible area in h equals want (a full build's) and
+ * hsr_check passes, else prints the mismatch and returns 0 */
+static int same_areas(const hsr_ctx *h, const double *want, double *got, int n, const char *what)
+{
+    int ok = 1;
+    areas(h, got, n);
+    for (int i = 0; i < n; i++)
+        if (fabs(got[i] - want[i]) > 1e-9 * fmax(fabs(want[i]), 65536.0)) {
+            printf("mismatch: MLR %d visible area after %s %.17g, full build %.17g\n", i, what, got[i], want[i]);
+            ok = 0;
+        }
+    if (hsr_check(h) != HSR_OK) { printf("mismatch: hsr_check failed after %s\n", what); ok = 0; }
+    return ok;
+}
+
 static int cmd_move(int argc, char **argv)
 {
     if (argc < 5) return usage();
     int K = atoi(argv[4]), rep = argc > 5 ? atoi(argv[5]) : 3;
     hsr_scene *sa = load(argv[2]), *sb = load(argv[3]);
     if (!sa || !sb) return 1;
-    if (sa->nf != sb->nf || K < 1 || K > sa->nf) { fprintf(stderr, "scenes differ in face count or bad K\n"); return 1; }
+    if (sa->nf != sb->nf || K < 1 || K > sa->nf || K > 64 || rep < 1) {
+        fprintf(stderr, "scenes differ in face count, or bad K (1..64) or REPEAT\n");
+        return 1;
+    }
     int n = sa->nf;
     hsr_ctx *ha, *hb; double *shade;
-    double t_build = INFINITY, t_rebuild = INFINITY, t_move = INFINITY, t_back = INFINITY;
+    double t_build = INFINITY, t_rebuild = INFINITY, t[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
     for (int r = 0; r < rep; r++) {
         double t0 = now();
         if (hsr_scene_build(sa, &ha, &shade) != HSR_OK) return 1;
@@ -259,43 +299,44 @@ static int cmd_move(int argc, char **argv)
     }
     if (hsr_scene_build(sb, &hb, &shade) != HSR_OK) return 1;
     free(shade);
+    int vis_a = count_visible(ha), vis_b = count_visible(hb), vis_moved = 0, vis_cycled = 0;
     geom *ga = calloc((size_t)K, sizeof *ga), *gb = calloc((size_t)K, sizeof *gb);
     for (int k = 0; k < K; k++)
         if (!grab(ha, n - K + k, &ga[k]) || !grab(hb, n - K + k, &gb[k])) {
             fprintf(stderr, "cannot take face geometry\n"); return 1;
         }
     int ok = 1;
-    double *aa = malloc(sizeof(double) * (size_t)n), *ab = malloc(sizeof(double) * (size_t)n);
+    double *aa = malloc(sizeof(double) * (size_t)n), *ab = malloc(sizeof(double) * (size_t)n),
+           *a0 = malloc(sizeof(double) * (size_t)n);
     areas(hb, ab, n);
+    areas(ha, a0, n);
+    /* per round: per-face move and back, the same as one change_many each, a rebuild */
     for (int r = 0; r < rep; r++) {
-        double t0 = now();
-        for (int k = 0; k < K; k++)
-            if (hsr_move(ha, n - K + k, gb[k].xy, gb[k].len, gb[k].nr, gb[k].pl) != HSR_OK) { fprintf(stderr, "move failed\n"); return 1; }
-        double dt = now() - t0;
-        if (dt < t_move) t_move = dt;
-        if (r == 0) {
-            areas(ha, aa, n);
-            for (int i = 0; i < n; i++)
-                if (fabs(aa[i] - ab[i]) > 1e-9 * fmax(fabs(ab[i]), 65536.0)) {
-                    printf("mismatch: MLR %d visible area after move %.17g, full build %.17g\n", i, aa[i], ab[i]);
-                    ok = 0;
-                }
-            if (hsr_check(ha) != HSR_OK) { printf("mismatch: hsr_check failed after move\n"); ok = 0; }
+        for (int many = 0; many < 2; many++) {
+            double dt = move_faces(ha, n, K, gb, many);
+            if (dt < 0) { fprintf(stderr, "move failed\n"); return 1; }
+            if (dt < t[2 * many]) t[2 * many] = dt;
+            if (r == 0) {
+                ok &= same_areas(ha, ab, aa, n, many ? "hsr_change_many" : "hsr_move");
+                if (many) vis_moved = count_visible(ha);
+            }
+            dt = move_faces(ha, n, K, ga, many);
+            if (dt < 0) { fprintf(stderr, "move failed\n"); return 1; }
+            if (dt < t[2 * many + 1]) t[2 * many + 1] = dt;
+            if (r == 0) ok &= same_areas(ha, a0, aa, n, many ? "hsr_change_many back" : "hsr_move back");
         }
-        t0 = now();
-        for (int k = 0; k < K; k++)
-            if (hsr_move(ha, n - K + k, ga[k].xy, ga[k].len, ga[k].nr, ga[k].pl) != HSR_OK) { fprintf(stderr, "move failed\n"); return 1; }
-        dt = now() - t0;
-        if (dt < t_back) t_back = dt;
-        t0 = now();
+        if (r == rep - 1) vis_cycled = count_visible(ha);
+        double t0 = now();
         if (hsr_rebuild(ha) != HSR_OK) return 1;
-        dt = now() - t0;
+        double dt = now() - t0;
         if (dt < t_rebuild) t_rebuild = dt;
     }
-    printf("faces %d moved %d visible_a %d visible_b %d build %.6f rebuild %.6f move %.6f move_back %.6f check %s\n",
-           n, K, count_visible(ha), count_visible(hb), t_build, t_rebuild, t_move, t_back, ok ? "ok" : "MISMATCH");
+    printf("faces %d moved %d visible_a %d visible_b %d build %.6f rebuild %.6f move %.6f move_back %.6f "
+           "move_many %.6f move_many_back %.6f visible_moved %d visible_cycled %d check %s\n",
+           n, K, vis_a, vis_b, t_build, t_rebuild, t[0], t[1], t[2], t[3], vis_moved, vis_cycled,
+           ok ? "ok" : "MISMATCH");
     for (int k = 0; k < K; k++) { free(ga[k].xy); free(ga[k].len); free(gb[k].xy); free(gb[k].len); }
-    free(ga); free(gb); free(aa); free(ab);
+    free(ga); free(gb); free(aa); free(ab); free(a0);
     hsr_destroy(ha); hsr_destroy(hb);
     hsr_scene_free(sa); hsr_scene_free(sb);
     return ok ? 0 : 1;
