@@ -12,6 +12,8 @@ BENCHES = [
     ("yproc", ".yproc", "y-processor: commands per line, host time; --scaling: time "
      "against triangle count"),
     ("hsr", ".hsr", "hidden-surface removal: Table 5.2, Fig. 5.30, incremental move"),
+    ("hsr-incr", ".hsr_incr", "incremental HSR against a full build: teapot + box, 10-10,000 parts, "
+     "the CAD drag, against --baseline-rev"),
     ("array", ".array", "Verilated array speed (1/8/72 chips) against the baseline revision"),
     ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames"),
     ("recon", ".recon", "image reconstruction report -> docs/reconstruction.md"),

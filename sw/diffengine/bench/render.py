@@ -20,6 +20,7 @@ DOC = REPO / "docs" / "performance.md"
 SECTIONS = {
     "model": (".model", "render"),
     "hsr": (".hsr", "render"),
+    "hsr-incr": (".hsr_incr", "render"),
     "array": (".array", "render"),
     "yproc": (".yproc", "render"),
     "yproc-scaling": (".yproc", "render_scaling"),
