@@ -81,7 +81,7 @@ void yp_anim_free(yp_anim *a);
 int yp_anim_frames(const yp_anim *a);
 hsr_scene *yp_anim_scene(yp_anim *a);          /* the live scene (frame last applied) */
 /* Set the scene to frame f.  With h != NULL also update the HSR
- * incrementally (hsr_move of the moved faces, hsr_set_opacity) and the
+ * incrementally (one hsr_change_many: the moved faces, the new opacities) and the
  * shader; *y0, *y1 receive the lines that may have changed (y0 == y1:
  * none).  With h == NULL only the scene changes (for a full rebuild). */
 hsr_status yp_anim_apply(yp_anim *a, int f, hsr_ctx *h, yp_shader *sh, int *y0, int *y1);
