@@ -236,6 +236,10 @@ def _anim_summary(frames: dict, sel) -> dict:
             "worst": max(i / f for i, f in zip(inc, full))}
 
 
+def _pct(x: float) -> str:
+    return f"{100 * x:.1f} %" if x >= 0.01 else f"{100 * x:.2f} %"
+
+
 def render(rec: dict) -> str:
     """The "Incremental HSR against a full build" section of docs/performance.md."""
     d = rec["data"]
@@ -259,7 +263,7 @@ def render(rec: dict) -> str:
             manyb = "-" if r["move_many_back"] == float("inf") else f"{r['move_many_back'] * 1e3:.2f}"
             L.append(f"| {r['faces']:,} | {name} | {r['build'] * 1e3:.1f} | {r['rebuild'] * 1e3:.1f} | "
                      f"{r['move'] * 1e3:.2f} | {r['move_back'] * 1e3:.2f} | {many} | {manyb} | "
-                     f"{100 * best / r['build']:.1f} % | {r['visible_a']:,} / {r['visible_cycled']:,} |")
+                     f"{_pct(best / r['build'])} | {r['visible_a']:,} / {r['visible_cycled']:,} |")
     L += ["", "**Scaling: N parts** (boxes of 12 triangles scattered in a 12 x 9 x 6 volume, side "
           "chosen so that about three cover each pixel; the part at the centre moved by its side; "
           "`diffengine bench hsr-incr` writes the scenes):", "",
@@ -269,7 +273,7 @@ def render(rec: dict) -> str:
     for n, rs in d["parts"].items():
         r = rs["this tree"]
         L.append(f"| {int(n):,} | {r['faces']:,} | {r['visible_a']:,} | {r['build'] * 1e3:.1f} | "
-                 f"{r['move_many'] * 1e3:.2f} | {100 * r['move_many'] / r['build']:.1f} % "
+                 f"{r['move_many'] * 1e3:.2f} | {_pct(r['move_many'] / r['build'])} "
                  + "".join(f"| {rs[nm]['move'] * 1e3:.2f} " for nm in names[1:]) + "|")
     L += ["", f"**CAD drag** (`yproc anim {ANIM}`, 640x480; per frame the min of the runs; "
           "incremental = HSR update + scan of the damaged lines, full = HSR rebuild + scan of every "
