@@ -524,14 +524,15 @@ static hsr_status merge_slots(hsr_ctx *h, const ivec *track)
 }
 
 /* Removes xs[0..nx-1] (marked not present by the caller) from the LLR and
- * repairs the damage. */
-static hsr_status repair(hsr_ctx *h, const int *xs, int nx)
+ * repairs the damage; the slots given new domains are appended to track (for
+ * merge_slots, after the caller's own adds). */
+static hsr_status repair(hsr_ctx *h, const int *xs, int nx, ivec *track)
 {
-    ivec R = {0, 0, 0}, track = {0, 0, 0};
+    ivec R = {0, 0, 0};
     hsr_domain *hole = NULL;
     HST_ADD(repairs, 1);
     hsr_status st = damage_remove(h, xs, nx, &R, &hole);
-    h->track = &track;
+    h->track = track;
     for (int i = 0; i < R.n && st == HSR_OK && hole; i++) {
         const mlr *P = &h->m[R.v[i]];
         if (!hsr_extent_overlap(P->dom->ext, hole->ext)) continue;
@@ -541,9 +542,8 @@ static hsr_status repair(hsr_ctx *h, const int *xs, int nx)
         if (st == HSR_OK) st = add_region(h, R.v[i], rem);
     }
     h->track = NULL;
-    if (st == HSR_OK) st = merge_slots(h, &track);
     hsr_domain_free(hole);
-    free(R.v); free(track.v);
+    free(R.v);
     return st;
 }
 
@@ -575,7 +575,10 @@ hsr_status hsr_remove(hsr_ctx *h, int id)
 {
     if (!id_ok(h, id)) return HSR_ENOTFOUND;
     h->m[id].present = 0;
-    hsr_status st = repair(h, &id, 1);
+    ivec track = {0, 0, 0};
+    hsr_status st = repair(h, &id, 1, &track);
+    if (st == HSR_OK) st = merge_slots(h, &track);
+    free(track.v);
     hsr_domain_free(h->m[id].dom);
     h->m[id].dom = NULL;
     return st;
@@ -607,15 +610,22 @@ hsr_status hsr_change_many(hsr_ctx *h, const hsr_change *c, int n)
     }
     if (st == HSR_OK) {
         if (nx > 1) qsort(xs, (size_t)nx, sizeof(int), cmp_int);
+        ivec track = {0, 0, 0};
         for (int i = 0; i < nx; i++) h->m[xs[i]].present = 0;
-        st = repair(h, xs, nx);
+        st = repair(h, xs, nx, &track);
         for (int i = 0; i < nx; i++) h->m[xs[i]].present = 1;
         for (int i = 0; i < n; i++) {
             mlr *M = &h->m[c[i].id];
             if (nd[i]) { hsr_domain_free(M->dom); M->dom = nd[i]; nd[i] = NULL; M->plane = c[i].plane; }
             if (c[i].opacity >= 0) M->opacity = c[i].opacity;
         }
+        /* the new domains' pieces are joined too: an add into a repaired LLR would
+         * otherwise leave pieces of one prefix apart that a build makes one */
+        h->track = &track;
         for (int i = 0; i < nx && st == HSR_OK; i++) st = add_domain(h, xs[i]);
+        h->track = NULL;
+        if (st == HSR_OK) st = merge_slots(h, &track);
+        free(track.v);
     }
     for (int i = 0; i < n && nd; i++) hsr_domain_free(nd[i]);
     free(nd); free(xs);
