@@ -257,8 +257,7 @@ static void test_hsr_drag_equals_build_and_stays_compact(void)
     part[1] = t_add_rect(h, 10, 10, 40, 25, 0, 2, 0.5);
     part[2] = t_add_rect(h, 5, 20, 25, 45, 0.02, 0, 1);
     hsr_ctx *g = rebuilt_copy(h);
-    int built = 0;
-    for (int s = 0; s < hsr_llr_slots(g); s++) built += hsr_llr_get(g, s, NULL, NULL, NULL, NULL);
+    int built = llr_count(g), worse = 0, excess = 0;   /* steps with more LLR domains than a build, most more */
     hsr_destroy(g);
     for (int back = 0; back < 2; back++)
         for (int step = 1; step <= 24; step++) {
@@ -279,13 +278,19 @@ static void test_hsr_drag_equals_build_and_stays_compact(void)
             else for (int k = 0; k < 3; k++) CHECK(hsr_move(h, c[k].id, c[k].xy, &n4, 1, c[k].plane) == HSR_OK);
             g = rebuilt_copy(h);
             same_visibility(h, g);
+            if (llr_count(h) > llr_count(g)) worse++;
+            if (llr_count(h) - llr_count(g) > excess) excess = llr_count(h) - llr_count(g);
             hsr_destroy(g);
         }
     /* back where it started: the same visibility as the first build, and the LLR no more
      * than a quarter larger than that build's (without the joins it grows with every step) */
     int now = llr_count(h);
-    printf("     LLR domains: first build %d, after 48 drag steps %d\n", built, now);
+    printf("     LLR domains: first build %d, after 48 drag steps %d; steps with more than a build: %d "
+           "(at most %d more)\n", built, now, worse, excess);
     CHECK(now <= built + built / 4);
+    /* a join needs overlapping extents: same-prefix pieces far apart, which a build may
+     * hold as one disconnected domain, stay apart (one more domain at 2 of the 48 steps) */
+    CHECK(excess <= 2);
     hsr_destroy(h);
 }
 
