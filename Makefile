@@ -92,6 +92,7 @@ test-c:
 	@./scripts/ensure_system.sh
 	$(MAKE) -C sw/hsr test
 	$(MAKE) -C sw/yproc test
+	$(MAKE) -C sw/fmodel test
 	$(MAKE) -C sw/hsr/fuzz smoke
 
 # Coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang; FUZZ_SECONDS each).
