@@ -153,6 +153,7 @@ bench-hsr: $(SETUP)
 
 bench: $(SETUP)
 	$(ENV) $(DE) bench model --write
+	$(ENV) $(DE) bench model --fast --write
 	$(ENV) $(DE) bench yproc --write
 
 # QUICK=1: the 72-chip rates (and the baseline's, when built) and the stream only.

@@ -18,6 +18,8 @@ from __future__ import annotations
 import random
 import re
 import subprocess
+import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -180,6 +182,20 @@ def test_shipped_scenes_full_colour(scans, name):
     assert np.array_equal(demo.golden(scans[name], 640, 480), want)   # the default: fast
 
 
+def test_colour_frame_within_budget(scans):
+    """Issue 19 item 4: a 640x480 colour frame in at most 50 ms. CPU time of this process,
+    best of 5 (wall time on this shared machine says more about the load than the model;
+    docs/performance.md, "Functional model in C", has both)."""
+    data = [p.read_bytes() for p in scans["teapot"]]
+    best = float("inf")
+    for _ in range(5):
+        t = time.process_time()
+        fast.render_frame(data, 640, 480)
+        best = min(best, time.process_time() - t)
+    print(f"teapot colour frame: {best * 1e3:.1f} CPU ms")
+    assert best < 0.050
+
+
 def test_changed_lines_only(scans):
     """render_lines: a frame updated line by line equals the full render of the new
     streams; rows not named stay as they were."""
@@ -265,13 +281,17 @@ def test_corrupted_streams_refused_at_the_same_slot():
             slots[k] = (ident, data)
         words = b"".join(((i << isa.WORD_BITS) | d).to_bytes(6, "big") for i, d in slots)
         try:
-            want = F.render(binfmt.deserialise(slots, "s"), 40)
+            cmds = binfmt.deserialise(slots, "s")
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")         # commands after the last Refresh
+                want = F.render(cmds, 40)
             want_slot = None
+            last = max((k for k, c in enumerate(cmds) if c.op == "REFRESH"), default=-1)
         except AsmError as e:
             want_slot = int(_SLOT.search(str(e)).group(1))
         out = np.zeros((len(slots), 40), dtype=np.uint16)
         try:
-            n, _ = fast.render_words(words, 40, out)
+            n, trailing = fast.render_words(words, 40, out)
             got_slot = None
         except fast.FastModelError as e:
             got_slot = int(_SLOT.search(str(e)).group(1))
@@ -279,6 +299,7 @@ def test_corrupted_streams_refused_at_the_same_slot():
         assert got_slot == want_slot, f"seed {seed} case {case}: numpy slot {want_slot}, C {got_slot}"
         if want_slot is None:
             assert np.array_equal(out[:n], want), f"seed {seed} case {case}"
+            assert trailing == len(cmds) - 1 - last, f"seed {seed} case {case}: trailing"
         refused += want_slot is not None
     assert 50 < refused < 390          # both kinds of stream were tried
 

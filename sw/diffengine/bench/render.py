@@ -19,6 +19,7 @@ DOC = REPO / "docs" / "performance.md"
 # section -> (module, function) whose function(record) -> the section's markdown
 SECTIONS = {
     "model": (".model", "render"),
+    "model-fast": (".model", "render_fast"),
     "hsr": (".hsr", "render"),
     "array": (".array", "render"),
     "yproc": (".yproc", "render"),

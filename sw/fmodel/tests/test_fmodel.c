@@ -2,26 +2,11 @@
  * the tight loop against the general one, the carry-bug adder, the stream decoder's
  * refusals (slot for slot as binfmt.deserialise), whole streams into images.
  * The comparison with the numpy golden model, command by command, is
- * sw/tests/test_fmodel.py. Prints "N passed, M failed" last. */
-#include <stdio.h>
-#include <stdlib.h>
+ * sw/tests/test_fmodel.py. Prints "N passed, M failed" last (t_report). */
 #include <string.h>
+#include "t.h"          /* the harness of the C libraries (sw/hsr/tests/t.h, t.c) */
 #include "fmodel.h"
 #include "de_isa.h"
-
-static int n_pass, n_fail, failed_now;
-static const char *cur;
-#define CHECK(c) do { if (!(c)) { failed_now = 1; \
-    fprintf(stderr, "FAIL %s (%s:%d): %s\n", cur, __FILE__, __LINE__, #c); } } while (0)
-static void run(const char *name, void (*fn)(void))
-{
-    cur = name; failed_now = 0;
-    fn();
-    if (failed_now) { n_fail++; printf("FAIL %s\n", name); }
-    else { n_pass++; printf("ok   %s\n", name); }
-    fflush(stdout);
-}
-#define RUN(fn) run(#fn, fn)
 
 #define ONE (INT64_C(1) << DE_FRAC_BITS)
 #define W 64
@@ -346,7 +331,8 @@ static void test_render(void)
 
 int main(int argc, char **argv)
 {
-    (void)argc; (void)argv;
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--quick")) t_quick = 1;
     RUN(test_eval_orders);
     RUN(test_quiet_equals_general);
     RUN(test_protect);
@@ -356,6 +342,5 @@ int main(int argc, char **argv)
     RUN(test_bad_commands);
     RUN(test_decode);
     RUN(test_render);
-    printf("%d passed, %d failed\n", n_pass, n_fail);
-    return n_fail != 0;
+    return t_report();
 }
