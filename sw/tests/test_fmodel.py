@@ -329,3 +329,19 @@ def test_errors_name_the_stream(tmp_path):
         fast.Line(0)
     with pytest.warns(UserWarning, match="1 command"):
         assert fast.render([C("EVAL", 0, 2, (ONE,)), C("REFRESH"), C("NOP")], 4).shape == (1, 4)
+
+
+def test_cli_model_level_fast(tmp_path):
+    """`diffengine model --level fast` renders the same raw pixels as the numpy level."""
+    import sys
+    from diffengine.formats.frame import read_png16
+    src = REPO / "sw/scenes/fig7_21a.cmd"
+    out = {}
+    for level in ("functional", "fast"):
+        png = tmp_path / f"{level}.png"
+        r = subprocess.run([sys.executable, "-m", "diffengine", "model", str(src), "-o", str(png),
+                            "--raw", "--carry-bug", "--width", "64", "--level", level],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        out[level] = read_png16(png)
+    assert out["fast"].any() and np.array_equal(out["fast"], out["functional"])

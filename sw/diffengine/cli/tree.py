@@ -88,7 +88,9 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("input", help="command file, .de48 or .de32")
         s.add_argument("-o", "--output", required=True)
         s.add_argument("--width", type=int, default=640, help="columns (PEs), default 640")
-        s.add_argument("--level", choices=["functional", "structural"], default="functional")
+        s.add_argument("--level", choices=["functional", "structural", "fast"], default="functional",
+                       help="functional (numpy, the reference; default), structural (cycle "
+                            "level) or fast (the C functional model, sw/fmodel)")
         s.add_argument("--carry-bug", action="store_true", help="model the §7.7 adder fault")
         s.add_argument("--compensate", action="store_true",
                        help="apply the mapper's carry-bug compensation to intensities")
