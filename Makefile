@@ -170,7 +170,7 @@ postsynth: $(SETUP)
 	$(MAKE) -C fpga postsynth
 
 clean:
-	rm -rf $(OUT) build sim/out sim/build sw/hsr/build sw/yproc/build fpga/build
+	rm -rf $(OUT) build sim/out sim/build sw/hsr/build sw/yproc/build sw/fmodel/build fpga/build
 	find tb -name 'sim_build*' -prune -exec rm -rf {} +
 	rm -f tb/de_array/coverage_*.txt tb/de_array/seed_*.txt
 	git worktree prune 2>/dev/null || true
