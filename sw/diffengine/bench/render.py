@@ -20,6 +20,7 @@ DOC = REPO / "docs" / "performance.md"
 SECTIONS = {
     "model": (".model", "render"),
     "hsr": (".hsr", "render"),
+    "table52": (".table52", "render"),
     "array": (".array", "render"),
     "yproc": (".yproc", "render"),
     "yproc-scaling": (".yproc", "render_scaling"),
