@@ -6,10 +6,10 @@
 (Table 5.2 and Figs. 5.13-5.18, the Grid-List on the six test scenes of section
 5.3.3: `diffengine bench table52`, bench/table52.py.)
 
-2. Fig. 5.30: HSR time against triangle count for tri-steps, tri-spets (both
+1. Fig. 5.30: HSR time against triangle count for tri-steps, tri-spets (both
    insertion orders) and the teapot; power-law exponents fitted.
-3. Teapot speed: microseconds per input triangle and per visible domain.
-4. Incremental move of one small object (a 12-triangle box in front of the
+2. Teapot speed: microseconds per input triangle and per visible domain.
+3. Incremental move of one small object (a 12-triangle box in front of the
    teapot) against a full rebuild, same run, with an equality check.
 
 Records out/bench/hsr.json (bench.record); --write keeps it in docs/bench, renders the

@@ -533,17 +533,24 @@ def render(rec: dict) -> str:
                   "source's loops, started ceil((w_Q + w_max) m / X) cells before the cell of Q.right "
                   "(section 5.3.1, 5.3.2), visit a superset, and count more:", ""]
         parts += scan_text(res)
-        parts += ["", "At m = 10 a cell holds ~1000 extents; sorted on decreasing right+top, the list of the "
-                  "query's own cell puts every extent above or right of the query, in that cell, before the "
-                  "ones that can overlap: about half the cell, ~500-650 entries against ~12 overlaps for "
-                  "query 10 (~40 for query 100). The source's 16.6 (query 10) means ~200 addressed, below what "
-                  "the lists force any scan of the query's own cell to visit (the *lower bound* column), so "
-                  "no change of the scan reproduces it; the difference is in the query (its size or units) "
-                  "or in what was counted, not in how far the lists are walked. Expression 5.3's second term "
-                  "(round-off), with i/m - Q.right/X a fraction of the window times N/m^2 extents per cell, "
-                  "is m times smaller than the round-off it describes (the strip is i/m - Q.right/X of the "
-                  "window wide and one cell high: N (i/m - Q.right/X)/m extents), which may be how the "
-                  "table and the expression came to agree in the source.", ""]
+        r10, r100 = res[10]["Random"][0], res[100]["Random"][0]
+        parts += ["", f"At m = 10 a cell holds ~1000 extents; sorted on decreasing right+top, the list of the "
+                  "query's own cell puts every extent above or right of the query (in that cell) before the "
+                  "ones that can overlap. Per query, Random, m = 10: the lists force "
+                  f"{r10['passed_ratio'] * r10['overlaps']:.0f} entries (query 10) and "
+                  f"{r100['passed_ratio'] * r100['overlaps']:.0f} (query 100) for {r10['overlaps']:.1f} and "
+                  f"{r100['overlaps']:.1f} overlaps; the source's ratios, {SOURCE[10]['Random'][0]} and "
+                  f"{SOURCE[100]['Random'][0]}, mean {SOURCE[10]['Random'][0] * r10['overlaps']:.0f} and "
+                  f"{SOURCE[100]['Random'][0] * r100['overlaps']:.0f} addressed for the same overlaps: fewer "
+                  "than the lists force any correct scan of those cells to pass, and fewer for the larger "
+                  "query, which no walk of sorted lists does. So no change of the scan reproduces the "
+                  "source's coarse grids: the difference is in the query (its size or units), the scene or "
+                  "what was counted, not in how far the lists are walked, and the real `hsr_gridlist_query` "
+                  "is left as it is. (A note on expression 5.3, which the source says its results are "
+                  "\"conform\": its second term (round-off), i/m - Q.right/X a fraction of the window times N/m^2 "
+                  "extents per cell, is m times smaller than the round-off it describes, a strip i/m - "
+                  "Q.right/X of the window wide and one cell high, which holds N (i/m - Q.right/X) / m extents.)",
+                  ""]
     if sw:
         parts += qsweep_text(sw, d["sweep_queries"])
         parts += ["", "No single query size reproduces a whole column of the source: the query-10 column is "
