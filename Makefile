@@ -32,7 +32,7 @@ help:
 	@echo "make test-quality the outlier gate at full size: shipped scenes + public meshes (sw/scenes/meshes)"
 	@echo "make bench       golden model speed, y-processor commands per line and host time"
 	@echo "                 (docs/performance.md)"
-	@echo "make bench-hsr   HSR benchmarks (Table 5.2, Fig 5.30) into docs/performance.md"
+	@echo "make bench-hsr   HSR benchmarks (Fig 5.30, move; Table 5.2, Figs 5.13-5.18) into docs/performance.md"
 	@echo "make bench-array Verilated array speed (1/8/72 chips) vs the models"
 	@echo "make bench-span  span-serial array: clocks per line on the teapot and CAD frames"
 	@echo "make waves TEST=<cocotb test> [PE=p] [BUG=0|1]"
@@ -150,6 +150,7 @@ fpga: $(SETUP)
 
 bench-hsr: $(SETUP)
 	$(ENV) $(DE) bench hsr --write $(BENCH_ARGS)
+	$(ENV) $(DE) bench table52 --write
 
 bench: $(SETUP)
 	$(ENV) $(DE) bench model --write

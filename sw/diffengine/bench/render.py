@@ -21,6 +21,7 @@ SECTIONS = {
     "model": (".model", "render"),
     "model-fast": (".model", "render_fast"),
     "hsr": (".hsr", "render"),
+    "table52": (".table52", "render"),
     "array": (".array", "render"),
     "yproc": (".yproc", "render"),
     "yproc-scaling": (".yproc", "render_scaling"),
