@@ -251,6 +251,7 @@ def make_app(engine: Engine):
                 await ws.send_bytes(blob)
             for r in replies:
                 await ws.send_json(r)
+            await ws.send_json({"type": "done", "request": msg.get("type")})
             if full is not None and sess.rtl_on and not sess.rtl_busy:
                 asyncio.ensure_future(check_rtl(full["frame"]))
         return ws
