@@ -172,10 +172,11 @@ class Session:
 
 # ---- the RTL check (background) ----------------------------------------------------------
 
-def rtl_check(streams: list[bytes], golden: np.ndarray) -> tuple[bool, str]:
-    """The streams through the Verilated display controller; (matched, summary)."""
+def rtl_check(streams: list, golden: np.ndarray, cfg=None, mode: int = 0) -> tuple[bool, str]:
+    """The streams through the Verilated display controller (default: the demo's 3 x 72
+    chips, 640x480), its last frame against the golden model's; (matched, summary)."""
     from ..rtl import dc_harness
-    frames, st = dc_harness.run(streams, dc_harness.Config(), mode=0)
+    frames, st = dc_harness.run(streams, cfg or dc_harness.Config(), mode=mode)
     got = frames[-1]
     diff = got != golden
     if diff.any():
