@@ -2,9 +2,9 @@
 path (viewer.server.Session: the requests the page sends, no browser, no socket) on the
 teapot-with-box and the CAD scene. Per step: pointer-to-frame latency (the drag request
 in, the frame band's bytes out) split into HSR, scan, `yproc serve` I/O, golden model and
-encode; then the refinement when the pointer rests. Baseline in the same run: the same
-frame rendered from scratch (HSR build + every line scanned + every line through the
-golden model), the viewer's starting frame.
+encode; then the refinement when the pointer rests. Baseline in the same run: a frame
+rendered from scratch (a new `yproc serve`: scene load, HSR build, every line scanned,
+every line through the golden model).
 """
 from __future__ import annotations
 
@@ -28,12 +28,12 @@ def pct(xs, p):
     return xs[min(len(xs) - 1, int(round(p / 100 * (len(xs) - 1))))]
 
 
-def drag(name: str, steps: int, budget: float, px: float, log) -> dict:
+def drag(name: str, steps: int, budget: float, px: float, log, model: str = "auto") -> dict:
     from ..viewer.engine import Engine
     from ..viewer.server import Session
     scene, obj, what = SCENES[name]
     t0 = time.perf_counter()
-    eng = Engine(scene, yproc.build(), budget_ms=budget)
+    eng = Engine(scene, yproc.build(), budget_ms=budget, model=model)
     open_s = time.perf_counter() - t0
     full0 = eng.last_ms
     try:
@@ -61,12 +61,12 @@ def drag(name: str, steps: int, budget: float, px: float, log) -> dict:
         # the baseline, same run: a frame from scratch (a new `yproc serve`: scene load,
         # HSR build, every line scanned, every line through the golden model)
         t = time.perf_counter()
-        Engine(scene, yproc.build(), budget_ms=budget).close()
+        Engine(scene, yproc.build(), budget_ms=budget, model=model).close()
         full_ms = (time.perf_counter() - t) * 1e3
     finally:
         eng.close()
     lat = [r["latency_ms"] for r in rows]
-    return {"scene": name, "file": str(scene.relative_to(REPO)), "dragged": what,
+    return {"scene": name, "file": str(scene.relative_to(REPO)), "dragged": what, "model": eng.model,
             "faces": eng.info["faces"], "steps": steps, "budget_ms": budget, "open_s": open_s,
             "first_frame_ms": full0, "median_ms": statistics.median(lat), "p95_ms": pct(lat, 95),
             "max_ms": max(lat),
@@ -85,6 +85,8 @@ def configure(ap) -> None:
     ap.add_argument("--px", type=float, default=2.0, help="pointer move per step, pixels")
     ap.add_argument("--budget-ms", type=float, default=50.0,
                     help="the viewer's frame budget (coarse frames above it)")
+    ap.add_argument("--model", choices=("auto", "fast", "numpy"), default="auto",
+                    help="golden model: C (diffengine.model.fast) when there (auto), or numpy")
     ap.add_argument("--write", action="store_true",
                     help="keep the record in docs/bench and update docs/performance.md")
     ap.set_defaults(func=command)
@@ -99,7 +101,7 @@ def command(a) -> int:
             run.log(f"error: unknown scene {name!r} (teapot, cad)")
             return 2
         run.log(f"{name}: {a.steps}-step drag through the viewer's server path")
-        res.append(drag(name, a.steps, a.budget_ms, a.px, run.log))
+        res.append(drag(name, a.steps, a.budget_ms, a.px, run.log, a.model))
         r = res[-1]
         run.log(f"{name}: median {r['median_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms; "
                 f"from scratch {r['scratch_ms']:.0f} ms")
@@ -117,13 +119,14 @@ def render(rec: dict) -> str:
            f"{rec['load_before']} before / {rec['load_after']} after on {d['cpus']} cores; "
            "wall-clock times, one process plus `yproc serve`, so each stage runs on one core):",
            "",
-           "| scene | dragged | steps | median ms | p95 ms | max ms | HSR | scan | serve I/O | "
+           "| scene | dragged | model | steps | median ms | p95 ms | max ms | HSR | scan | serve I/O | "
            "model | encode | coarse steps | HSR rebuilds | changed lines | rest (refine) ms | "
            "from scratch ms |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in d["scenes"]:
         s = r["stage_median_ms"]
-        out.append(f"| {r['scene']} ({r['faces']} faces) | {r['dragged']} | {r['steps']} | "
+        out.append(f"| {r['scene']} ({r['faces']} faces) | {r['dragged']} | "
+                   f"{r.get('model', 'numpy')} | {r['steps']} | "
                    f"{r['median_ms']:.0f} | {r['p95_ms']:.0f} | {r['max_ms']:.0f} | "
                    f"{s['hsr_ms']:.0f} | {s['scan_ms']:.0f} | {s['serve_io_ms']:.0f} | "
                    f"{s['model_ms']:.0f} | {s['encode_ms']:.1f} | {r['coarse_steps']} | "

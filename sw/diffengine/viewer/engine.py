@@ -20,7 +20,22 @@ from ..formats import binfmt
 from ..model import functional
 from ..pipeline.anim import lines_of_de48, to_de48
 
+try:   # the functional model in C (issue 19 item 4, sw/fmodel), where the tree has it
+    from ..model import fast as _fast
+except ImportError:
+    _fast = None
+
 SHADINGS = ("flat", "gouraud", "phong")
+MODELS = ("auto", "fast", "numpy")
+
+
+def model_name(model: str) -> str:
+    """'auto' -> 'fast' when diffengine.model.fast is there, else 'numpy'."""
+    if model not in MODELS:
+        raise EngineError(f"model must be one of {', '.join(MODELS)}, not {model!r}")
+    if model == "fast" and _fast is None:
+        raise EngineError("this tree has no diffengine.model.fast (the C functional model)")
+    return "numpy" if model == "numpy" or _fast is None else "fast"
 
 
 class EngineError(RuntimeError):
@@ -52,10 +67,13 @@ class Engine:
     """A scene in a long-lived `yproc serve` process, pixels from the golden model.
 
     budget_ms: a drag frame whose estimated cost exceeds it is rendered coarse (no AA,
-    flat shading on the damaged lines) and refined by `rest()`.
+    flat shading on the damaged lines) and refined by `rest()`. model: the golden model
+    that makes the pixels: "numpy" (functional.render, the reference), "fast" (its C
+    twin, diffengine.model.fast, held equal to it by its tests) or "auto" (fast if there).
     """
 
-    def __init__(self, scene, yproc: Path, budget_ms: float = 50.0):
+    def __init__(self, scene, yproc: Path, budget_ms: float = 50.0, model: str = "auto"):
+        self.model = model_name(model)
         self.scene = Path(scene)
         self.dir = Path(tempfile.mkdtemp(prefix="de_view_"))
         self.proc = subprocess.Popen([str(yproc), "serve", str(self.scene), "--dir", str(self.dir)],
@@ -211,18 +229,21 @@ class Engine:
         rep = self.request("frame coarse" if coarse else "frame full")
         t1 = time.perf_counter()
         rows: set[int] = set()
+        changes: list[dict[int, bytes]] = []
         for c, name in enumerate("rgb"):
             ys = rep["changed"][c]
-            if not ys:
-                continue
-            got = lines_of_de48(self.dir / f"{name}.de48")
+            got = lines_of_de48(self.dir / f"{name}.de48") if ys else []
             if len(got) != len(ys):
                 raise EngineError(f"{name}.de48 holds {len(got)} lines, the reply names {len(ys)}")
-            cmds, _ = binfmt.load_commands(to_de48(got), f"{name}.de48")
-            self.image[ys, :, c] = functional.render(cmds, self.W)
+            changes.append(dict(zip(ys, got)))
+            if ys and self.model == "numpy":
+                cmds, _ = binfmt.load_commands(to_de48(got), f"{name}.de48")
+                self.image[ys, :, c] = functional.render(cmds, self.W)
             for y, words in zip(ys, got):
                 self.lines[c][y] = words
             rows.update(ys)
+        if rows and self.model == "fast":
+            _fast.render_lines(self.image, changes)
         t2 = time.perf_counter()
         serve_ms = (t1 - t0) * 1e3
         stats = {
@@ -232,6 +253,7 @@ class Engine:
             "serve_io_ms": max(serve_ms - rep["scan_ms"], 0.0), "model_ms": (t2 - t1) * 1e3,
             "max_slots": rep["max_slots"], "capacity": rep["capacity"],
             "lines_degraded": rep["lines_degraded"], "lines_overflow": rep["lines_overflow"],
+            "model": self.model,
         }
         cost = rep["hsr_ms"] + serve_ms + stats["model_ms"]
         if not coarse:

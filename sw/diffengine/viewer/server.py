@@ -35,6 +35,7 @@ light, AA/shading toggles, undo/redo, per-frame statistics and an optional RTL c
 (docs/viewer.md). Binds to 127.0.0.1 only. Ctrl-C stops it.
 
     diffengine view [--scene sw/scenes/cad/cad.scene] [--port 8765] [--budget-ms 50]
+                    [--model auto|fast|numpy]
 """
 
 
@@ -264,12 +265,12 @@ def make_app(engine: Engine):
     return app
 
 
-def serve(scene, port: int = 8765, budget_ms: float = 50.0, ready=None) -> None:
+def serve(scene, port: int = 8765, budget_ms: float = 50.0, ready=None, model: str = "auto") -> None:
     """Run the viewer until interrupted (ready(port) is called once it listens)."""
     from aiohttp import web
 
     from ..host import yproc
-    engine = Engine(scene, yproc.build(), budget_ms=budget_ms)
+    engine = Engine(scene, yproc.build(), budget_ms=budget_ms, model=model)
     app = make_app(engine)
 
     async def main():
@@ -278,7 +279,8 @@ def serve(scene, port: int = 8765, budget_ms: float = 50.0, ready=None) -> None:
         site = web.TCPSite(runner, HOST, port)
         await site.start()
         real = site._server.sockets[0].getsockname()[1]
-        print(f"view: {engine.scene} ({engine.W}x{engine.H}, {engine.info['faces']} faces) on "
+        print(f"view: {engine.scene} ({engine.W}x{engine.H}, {engine.info['faces']} faces, "
+              f"{engine.model} golden model) on "
               f"http://{HOST}:{real}/  (Ctrl-C stops)", flush=True)
         if ready:
             ready(real)
@@ -288,6 +290,12 @@ def serve(scene, port: int = 8765, budget_ms: float = 50.0, ready=None) -> None:
         finally:
             await runner.cleanup()
 
+    if threading.current_thread() is threading.main_thread():   # kill = Ctrl-C: clean up
+        import signal
+
+        def stop(*_):
+            raise KeyboardInterrupt
+        signal.signal(signal.SIGTERM, stop)
     try:
         asyncio.run(main())
     except KeyboardInterrupt:
@@ -303,6 +311,9 @@ def configure(ap) -> None:
     ap.add_argument("--port", type=int, default=8765, help="TCP port on 127.0.0.1 (0: any free one)")
     ap.add_argument("--budget-ms", type=float, default=50.0,
                     help="frame budget: a drag frame costing more is rendered coarse first")
+    ap.add_argument("--model", choices=("auto", "fast", "numpy"), default="auto",
+                    help="golden model for the pixels: the C one (diffengine.model.fast) when "
+                    "the tree has it (auto), or the numpy reference")
     ap.set_defaults(func=command)
 
 
@@ -311,7 +322,7 @@ def command(a) -> int:
         print(f"view: error: {a.scene}: no such scene file", file=sys.stderr)
         return 1
     try:
-        serve(a.scene, a.port, a.budget_ms)
+        serve(a.scene, a.port, a.budget_ms, model=a.model)
     except EngineError as ex:
         print(f"view: error: {ex}", file=sys.stderr)
         return 1
