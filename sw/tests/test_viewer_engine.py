@@ -159,3 +159,21 @@ def test_rtl_check_marks_match_and_mismatch():
     bad[5, 7, 1] ^= 1
     ok, why = rtl_check(streams, bad, cfg, mode=3)
     assert not ok and "(7, 5) G" in why, why
+
+
+def test_split_lines_equals_lines_of_de48(yproc, tmp_path):
+    """The viewer's vectorised line splitter against pipeline.anim's word-at-a-time one,
+    on a real frame, and its refusals."""
+    from diffengine.viewer.engine import EngineError, split_lines
+    subprocess.run([str(yproc), "scan", str(ANIM_SCENE), "-o", str(tmp_path)], check=True,
+                   capture_output=True)
+    for c in "rgb":
+        got = split_lines(tmp_path / f"{c}.de48")
+        assert len(got) == 480 and got == lines_of_de48(tmp_path / f"{c}.de48")
+    data = (tmp_path / "r.de48").read_bytes()
+    (tmp_path / "cut.de48").write_bytes(data[:-6])          # the last Refresh missing
+    with pytest.raises(EngineError, match="after the last Refresh"):
+        split_lines(tmp_path / "cut.de48")
+    (tmp_path / "odd.de48").write_bytes(data[:-3])
+    with pytest.raises(EngineError, match="truncated"):
+        split_lines(tmp_path / "odd.de48")

@@ -16,9 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import isa
 from ..formats import binfmt
 from ..model import functional
-from ..pipeline.anim import lines_of_de48, to_de48
+from ..pipeline.anim import to_de48
 
 try:   # the functional model in C (issue 19 item 4, sw/fmodel), where the tree has it
     from ..model import fast as _fast
@@ -40,6 +41,24 @@ def model_name(model: str) -> str:
 
 class EngineError(RuntimeError):
     """`yproc serve` refused a request (the message says why) or died."""
+
+
+def split_lines(path: Path) -> list[bytes]:
+    """A .de48 file of whole lines -> one bytes object per line (its Refresh last): what
+    pipeline.anim.lines_of_de48 returns, vectorised (the viewer reads every frame's
+    changed lines; a word at a time in Python costs more than the C model's render)."""
+    data = Path(path).read_bytes()
+    binfmt._check_header(data, binfmt.DE48_MAGIC, str(path))
+    body = np.frombuffer(data, np.uint8, offset=binfmt.HEADER_LEN)
+    if body.size % 6:
+        raise EngineError(f"{path}: truncated instruction ({body.size % 6} of 6 bytes)")
+    w = body.reshape(-1, 6)
+    ident = ((w[:, 0].astype(np.uint16) << 8) | w[:, 1]) >> 4
+    ends = np.flatnonzero(ident == isa.REFRESH) + 1
+    if ends.size and ends[-1] != len(w) or (not ends.size and len(w)):
+        raise EngineError(f"{path}: words after the last Refresh")
+    raw, starts = data[binfmt.HEADER_LEN:], np.concatenate(([0], ends[:-1]))
+    return [raw[6 * a:6 * b] for a, b in zip(starts.tolist(), ends.tolist())]
 
 
 @dataclass
@@ -227,23 +246,26 @@ class Engine:
         if coarse is None:
             coarse = self.last_ms > self.budget_ms
         rep = self.request("frame coarse" if coarse else "frame full")
-        t1 = time.perf_counter()
         rows: set[int] = set()
         changes: list[dict[int, bytes]] = []
         for c, name in enumerate("rgb"):
             ys = rep["changed"][c]
-            got = lines_of_de48(self.dir / f"{name}.de48") if ys else []
+            got = split_lines(self.dir / f"{name}.de48") if ys else []
             if len(got) != len(ys):
                 raise EngineError(f"{name}.de48 holds {len(got)} lines, the reply names {len(ys)}")
             changes.append(dict(zip(ys, got)))
-            if ys and self.model == "numpy":
-                cmds, _ = binfmt.load_commands(to_de48(got), f"{name}.de48")
-                self.image[ys, :, c] = functional.render(cmds, self.W)
             for y, words in zip(ys, got):
                 self.lines[c][y] = words
             rows.update(ys)
+        t1 = time.perf_counter()          # the lines are read: the rest is the model
         if rows and self.model == "fast":
             _fast.render_lines(self.image, changes)
+        elif rows:
+            for c, ch in enumerate(changes):
+                if ch:
+                    ys = list(ch)
+                    cmds, _ = binfmt.load_commands(to_de48([ch[y] for y in ys]), "rgb"[c] + ".de48")
+                    self.image[ys, :, c] = functional.render(cmds, self.W)
         t2 = time.perf_counter()
         serve_ms = (t1 - t0) * 1e3
         stats = {
