@@ -246,8 +246,11 @@ def make_app(engine: Engine):
                 continue
             try:
                 replies, blob, full = await loop.run_in_executor(loop_exec, run, msg)
-            except (BadRequest, EngineError) as ex:
+            except BadRequest as ex:
                 await ws.send_json({"type": "error", "error": f"malformed message: {ex}"})
+                continue
+            except EngineError as ex:        # yproc serve refused or died: say so, go on
+                await ws.send_json({"type": "error", "error": f"request failed: {ex}"})
                 continue
             if blob is not None:
                 await ws.send_bytes(blob)
