@@ -177,3 +177,27 @@ def test_split_lines_equals_lines_of_de48(yproc, tmp_path):
     (tmp_path / "odd.de48").write_bytes(data[:-3])
     with pytest.raises(EngineError, match="truncated"):
         split_lines(tmp_path / "odd.de48")
+
+
+def test_drag_offsets_in_the_image_plane_and_in_depth():
+    """A pointer move of (dx, dy) pixels moves the part's centroid by (dx, dy) pixels on
+    the screen (to first order); a depth drag moves it away from the eye along the ray
+    through it, so it stays where it is on the screen."""
+    e = _engine(1e9)
+    try:
+        v = e.info["view"]
+        u, vv, w, eye, f = (np.asarray(v[k]) for k in ("u", "v", "w", "eye", "f"))
+        c0 = np.asarray(e.info["objects"][SLIDER]["centroid"])
+
+        def screen(p):
+            d = p - eye
+            z = -d @ w
+            return np.array([f * (d @ u) / z, -f * (d @ vv) / z])
+
+        off = np.asarray(e.drag_offset(SLIDER, (0, 0, 0), 10.0, -4.0))
+        assert np.allclose(screen(c0 + off) - screen(c0), [10.0, -4.0], atol=0.05)
+        deep = np.asarray(e.drag_offset(SLIDER, (0, 0, 0), 0.0, 0.0, 20.0))
+        assert np.linalg.norm(c0 + deep - eye) > np.linalg.norm(c0 - eye)
+        assert np.allclose(screen(c0 + deep), screen(c0), atol=1e-6)   # stays under the pointer
+    finally:
+        e.close()

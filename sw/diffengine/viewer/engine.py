@@ -161,11 +161,13 @@ class Engine:
 
     def drag_offset(self, obj: int, start: tuple, dx: float, dy: float, dz: float = 0.0) -> tuple:
         """obj's world offset after a pointer move of (dx, dy) pixels in the image plane
-        (y down) and dz pixels in depth (positive: away from the eye) from `start`."""
+        (y down) and dz pixels in depth (positive: away from the eye, along the ray through
+        the centroid, so the part stays under the pointer) from `start`."""
         v = self.info["view"]
         s = self.world_per_pixel(obj)
-        d = (dx * s * np.asarray(v["u"]) - dy * s * np.asarray(v["v"])
-             - dz * s * np.asarray(v["w"]))
+        ray = (np.add(self.info["objects"][obj]["centroid"], start) - np.asarray(v["eye"]))
+        ray /= max(float(np.linalg.norm(ray)), 1e-12)
+        d = dx * s * np.asarray(v["u"]) - dy * s * np.asarray(v["v"]) + dz * s * ray
         return tuple(float(a) for a in np.asarray(start) + d)
 
     # ---- edits (each one records nothing; commit() closes an undo step) -----------------
