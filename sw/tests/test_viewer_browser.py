@@ -46,19 +46,25 @@ def _driver():
     return webdriver.Chrome(service=Service(drv), options=opts)
 
 
-@pytest.fixture(scope="module")
-def server():
+def _start(budget_ms: float) -> int:
+    """A viewer on a free port in a daemon thread; its port."""
     from diffengine.viewer import server as vs
     port = {}
     ready = threading.Event()
 
     def run():
-        vs.serve(SCENE, port=0, budget_ms=1e9, ready=lambda p: (port.setdefault("p", p), ready.set()))
+        vs.serve(SCENE, port=0, budget_ms=budget_ms,
+                 ready=lambda p: (port.setdefault("p", p), ready.set()))
 
-    th = threading.Thread(target=run, daemon=True)
-    th.start()
+    threading.Thread(target=run, daemon=True).start()
     assert ready.wait(120), "the viewer did not start listening"
-    yield port["p"]
+    return port["p"]
+
+
+@pytest.fixture(scope="module")
+def server():
+    """Never coarse (budget 1e9): every frame is full quality, comparable bit for bit."""
+    yield _start(1e9)
 
 
 @pytest.fixture(scope="module")
@@ -223,3 +229,27 @@ def test_binds_to_loopback_only(server):
     for addr in others:
         with pytest.raises(OSError):
             socket.create_connection((addr, server), timeout=2).close()
+
+
+def test_page_shows_coarse_frames_and_their_refinement():
+    """Item 6 on the page: with a zero budget the drag frames are coarse (the legend turns
+    amber), and on release the coarse lines are refined (the legend says so)."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+    port = _start(0.0)
+    d = _driver()
+    try:
+        d.get(f"http://127.0.0.1:{port}/")
+        wait(d, "return window.deState && window.deState.frames > 0;", "the first frame")
+        cv = d.find_element(By.ID, "frame")
+        w, h = cv.size["width"], cv.size["height"]
+        x, y = 460, 230          # the slider block of anim.scene
+        ActionChains(d).move_to_element_with_offset(cv, x - w / 2, y - h / 2).click_and_hold() \
+            .move_by_offset(15, 0).move_by_offset(15, 0).release().perform()
+        wait(d, "return window.deState.coarseSeen > 0;", "a coarse frame")
+        wait(d, "return document.getElementById('degraded').textContent.startsWith('refined');",
+             "the refinement at rest")
+        assert text(d, "st-coarse") == "0"
+        assert d.execute_script("return document.getElementById('degraded').className;") == "off"
+    finally:
+        d.quit()

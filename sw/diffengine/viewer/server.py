@@ -264,7 +264,6 @@ def make_app(engine: Engine):
     app = web.Application()
     app.router.add_get("/", index)
     app.router.add_get("/ws", ws_handler)
-    app["session"] = sess
     return app
 
 
