@@ -21,7 +21,7 @@ import pytest
 
 from diffengine import REPO
 from diffengine.host import yproc
-from diffengine.pipeline.anim import frames as anim_frames, render_lines
+from diffengine.pipeline.anim import lines_of_de48, render_lines
 
 SCENE = REPO / "sw/scenes/anim/anim.scene"
 # the screenshot: out/viewer/viewer.png on every run; DE_VIEWER_SHOT=docs also refreshes
@@ -110,7 +110,6 @@ def full_render(tmp: Path, moves: dict, opacity: dict | None = None) -> np.ndarr
     out = tmp / "anim_out"
     subprocess.run([str(yproc.build()), "anim", str(anim), "-o", str(out), "--full"], check=True,
                    capture_output=True)
-    from diffengine.pipeline.anim import lines_of_de48
     W = 640
     img = np.stack([render_lines(lines_of_de48(out / "frame001" / f"{c}.de48"), W) for c in "rgb"], -1)
     return (img >> 4).astype(np.uint8)
