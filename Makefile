@@ -15,7 +15,6 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-# view: the interactive viewer (docs/viewer.md)
 .PHONY: view gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
