@@ -15,13 +15,16 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: view gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
 	@echo "                 controller (3 x 72 chips) and golden model -> out/demo.png, PSNR"
 	@echo "                 (SCENE=file.scene CHIPS=72 THREADS=1 RTL=0 for model only;"
 	@echo "                 first run builds the model: ~1-1.5 min on 2 cores; the RTL frame ~35 s)"
+	@echo "make view        interactive viewer on http://127.0.0.1:PORT/ (default 8765): pick, drag,"
+	@echo "                 opacity, light, undo, statistics (SCENE=... default the CAD scene;"
+	@echo "                 SCENE=sw/scenes/teapot/teapot_box.scene; docs/viewer.md)"
 	@echo "make anim        the shipped animation through incremental frame deltas -> out/anim"
 	@echo "make demo-cmd    one command file through the golden model (DEMO_FILE=...)"
 	@echo "make test        run every test (sets itself up on first use)"
@@ -67,6 +70,14 @@ demo: $(SETUP)
 ANIM ?= sw/scenes/anim/cad_drag.anim
 anim: $(SETUP)
 	$(ENV) $(DE) anim --anim $(ANIM) --out $(OUT)/anim
+
+# The interactive viewer (docs/viewer.md): SCENE given on the command line, else the CAD scene.
+VIEW_SCENE := $(if $(filter command line environment,$(origin SCENE)),$(SCENE),sw/scenes/cad/cad.scene)
+PORT ?= 8765
+view: $(SETUP)
+	@./scripts/ensure_system.sh
+	@$(MAKE) -s -C sw/yproc build/yproc
+	$(ENV) $(DE) view --scene $(VIEW_SCENE) --port $(PORT)
 
 # One command file through the golden model (the first demo, before the pipeline).
 demo-cmd: $(SETUP)

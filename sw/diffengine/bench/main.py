@@ -17,6 +17,7 @@ BENCHES = [
     ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames"),
     ("recon", ".recon", "image reconstruction report -> docs/reconstruction.md"),
     ("recon-images", ".recon_images", "the reconstruction test images -> sw/images"),
+    ("viewer", ".viewer", "viewer: pointer-to-frame latency of a scripted drag (teapot, CAD)"),
     ("render", ".render", "docs/performance.md sections from docs/bench/*.json"),
 ]
 

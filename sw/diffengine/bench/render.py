@@ -26,6 +26,7 @@ SECTIONS = {
     "yproc": (".yproc", "render"),
     "yproc-scaling": (".yproc", "render_scaling"),
     "span": (".span", "render"),
+    "viewer": (".viewer", "render"),
 }
 
 
