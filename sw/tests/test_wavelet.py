@@ -55,10 +55,40 @@ def test_synthesis_is_piecewise_linear_with_few_knots():
     knots = np.flatnonzero(np.abs(np.diff(r, 2)) > WV.KNOT_TOL)
     assert 1 <= len(knots) <= 3
     lc = WV.line_commands(r)
-    assert lc.kind == "spline"
+    assert lc.kind in ("spline", "mixed") and lc.spline_px >= 16   # the hat is an Eval2
     assert ES.slot_count(lc.commands) < 20       # not a raster (257)
     np.testing.assert_array_equal(functional.render(lc.commands, 256)[0],
                                   np.clip(np.floor(r + 0.5), 0, 4095))
+
+
+def _plan_cost(segs, knot, target):
+    c = 0
+    for a, b, spline in segs:
+        if spline:
+            c += WV.EVAL2_SLOTS + WV.SET_SLOTS * int(knot[a + 1:b - 1].sum())
+        else:
+            c += WV.EVAL0_SLOTS * (1 + int(np.count_nonzero(target[a + 1:b] != target[a:b - 1])))
+    return c
+
+
+@pytest.mark.parametrize("trial", range(5))
+def test_segment_plan_is_optimal(trial):
+    # O(n) running-minimum DP against an O(n^2) brute force over segment starts
+    seed = _seed() + trial
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 60))
+    knot = rng.random(n) < rng.random()
+    knot[0] = knot[-1] = False
+    target = np.cumsum(rng.random(n) < rng.random()).astype(np.int64)
+    segs = WV.segment_plan(knot, target)
+    assert segs[0][0] == 0 and segs[-1][1] == n
+    assert all(s[1] == t[0] for s, t in zip(segs, segs[1:]))
+    best = [0] + [None] * n
+    for i in range(1, n + 1):
+        best[i] = min(best[j] + min(_plan_cost([(j, i, True)], knot, target),
+                                    _plan_cost([(j, i, False)], knot, target))
+                      for j in range(i))
+    assert _plan_cost(segs, knot, target) == best[n], f"SEED={seed}"
 
 
 def test_line_commands_patch_out_of_range_values():
@@ -162,7 +192,8 @@ def test_codec_lines_use_knots_on_smooth_images():
     x = (300 + 20 * xx + 30 * yy + 200 * np.sin(xx / 17.0)).astype(np.int64)
     data = WV.encode_file(x, 64.0)
     streams, sim, st = WV.decode_file(data)
-    assert st["spline_lines"] == 32
+    assert st["spline_lines"] + st["mixed_lines"] == 32
+    assert st["spline_px"] > 0.9 * x.size
     assert ES.slot_count(streams[0]) < 0.5 * 32 * 129
     np.testing.assert_array_equal(_golden(streams, 128), WV.float_decode(data))
     assert ES.psnr(sim, x) > 40.0

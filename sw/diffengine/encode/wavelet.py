@@ -282,26 +282,89 @@ def synth_line(hc: np.ndarray, lay: Layout) -> np.ndarray:
 class LineCode:
     commands: list[Command]
     pixels: np.ndarray
-    kind: str            # "spline" (Eval2 + SetdI knots) or "rle" (Eval0 runs)
+    kind: str            # "spline" (all knots), "rle" (all Eval0 runs) or "mixed"
     knots: int
+    spline_px: int       # pixels drawn by Eval2 segments
+
+
+EVAL2_SLOTS, SET_SLOTS, EVAL0_SLOTS = 4, 2, 1
+
+
+def segment_plan(knot: np.ndarray, target: np.ndarray) -> list[tuple[int, int, bool]]:
+    """Cheapest cover of the line by segments [a, b): True = one Eval2 + a SetdI per knot
+    inside (knots k with a + 1 <= k <= b - 2), False = Eval0 runs of the target pixels.
+    knot[k] marks a change of slope at k. Dynamic programming over segment ends; both
+    costs split into a part of the start and a part of the end, so a running minimum
+    over the starts makes it O(n)."""
+    n = len(target)
+    K = [0] + np.cumsum(knot.astype(np.int64)).tolist()                 # K[i] = knots < i
+    st = [1] + (target[1:] != target[:-1]).astype(np.int64).tolist()    # run starts
+    R = [0] + np.cumsum(st).tolist()                                     # R[i] = starts < i
+    best = [0] * (n + 1)
+    back = [(0, False)] * (n + 1)
+    INF = 1 << 62
+    rmin, rarg = INF, 0          # min over j < i of best[j] - E0 (R[j] + st[j])  (Eval0)
+    smin, sarg = INF, 0          # min over j <= i - 2 of best[j] - 2 K[j + 1]  (Eval2)
+    for i in range(1, n + 1):
+        j = i - 1
+        v = best[j] - EVAL0_SLOTS * (R[j] + st[j])
+        if v < rmin:
+            rmin, rarg = v, j
+        rle = rmin + EVAL0_SLOTS * (R[i] + 1)
+        spl, sj = best[j] + EVAL2_SLOTS, j                   # a one-pixel Eval2
+        if i >= 2:
+            v = best[i - 2] - SET_SLOTS * K[i - 1]
+            if v < smin:
+                smin, sarg = v, i - 2
+            c = smin + EVAL2_SLOTS + SET_SLOTS * K[i - 1]
+            if c < spl:
+                spl, sj = c, sarg
+        if spl < rle:
+            best[i], back[i] = spl, (sj, True)
+        else:
+            best[i], back[i] = rle, (rarg, False)
+    segs = []
+    i = n
+    while i > 0:
+        j, spline = back[i]
+        segs.append((j, i, spline))
+        i = j
+    return segs[::-1]
 
 
 def line_commands(r: np.ndarray) -> LineCode:
-    """A piecewise-linear line (float) -> the cheaper of its knot program and Eval0 runs."""
+    """A piecewise-linear line (float) -> commands: the cheapest mix of Eval2 + SetdI
+    segments and Eval0 runs (segment_plan) whose pixels are clip(round(r))."""
     n = len(r)
     target = np.clip(np.floor(r + 0.5), 0, PIXEL_MAX).astype(np.int64)
-    dd = np.abs(np.diff(r, 2)) if n >= 3 else np.zeros(0)
-    knots = np.flatnonzero(dd > KNOT_TOL) + 1
-    p = ES.quantise(r, knots, 1)
-    # operands wrap mod 2^36 (a line above 4095 comes out mod 4096) and the 12.24 feedback
-    # can land a value that is within 2^-24 of a half on the other side: patch both
-    p.patches = ES.patch_runs(p.pixels() != target, target)
-    cmds = ES.emit(p, "merged")
-    pix = p.pixels()
-    rle_cmds, rle_pix = ER.rle_line(pix, 0)
-    if ES.slot_count(rle_cmds) < ES.slot_count(cmds):
-        return LineCode(rle_cmds, rle_pix, "rle", len(p.knots))
-    return LineCode(cmds, pix, "spline", len(p.knots))
+    knot = np.zeros(n, dtype=bool)
+    if n >= 3:
+        knot[1:n - 1] = np.abs(np.diff(r, 2)) > KNOT_TOL
+    cmds: list[Command] = []
+    pix = np.empty(n, dtype=np.int64)
+    nk = spx = 0
+    kinds = set()
+    for a, b, spline in segment_plan(knot, target):
+        kinds.add(spline)
+        if not spline:
+            run_cmds, pix[a:b] = ER.rle_line(target[a:b], 0)
+            cmds += [Command("EVAL0", a + c.x, c.dx, c.values) for c in run_cmds[:-1]]
+            continue
+        ks = np.flatnonzero(knot[a + 1:b - 1]) + 1
+        p = ES.quantise(r[a:b], ks, 1)
+        # operands wrap mod 2^36 (a line above 4095 comes out mod 4096) and the 12.24
+        # feedback can land a value within 2^-24 of a half on the other side: patch both
+        p.patches = ES.patch_runs(p.pixels() != target[a:b], target[a:b])
+        seg = ES.emit(p, "merged")[:-1]
+        cmds += [Command(c.op, a + c.x, c.dx, c.values) for c in seg]
+        pix[a:b] = p.pixels()
+        nk += len(p.knots)
+        spx += b - a
+    kind = "mixed" if len(kinds) > 1 else ("spline" if True in kinds else "rle")
+    return LineCode(cmds + [Command("REFRESH")], pix, kind, nk, spx)
+
+
+STATS = ("spline_lines", "rle_lines", "mixed_lines", "knots", "spline_px")
 
 
 def channel_commands(C: np.ndarray, lay: Layout) -> tuple[list[Command], np.ndarray, dict]:
@@ -309,13 +372,14 @@ def channel_commands(C: np.ndarray, lay: Layout) -> tuple[list[Command], np.ndar
     simulation, stats)."""
     H = line_rows(C, lay)
     cmds, pix = [], []
-    st = {"spline_lines": 0, "rle_lines": 0, "knots": 0}
+    st = dict.fromkeys(STATS, 0)
     for y in range(lay.height):
         lc = line_commands(synth_line(H[y], lay))
         cmds += lc.commands
         pix.append(lc.pixels)
         st[lc.kind + "_lines"] += 1
         st["knots"] += lc.knots
+        st["spline_px"] += lc.spline_px
     return cmds, np.array(pix, dtype=np.int64), st
 
 
@@ -324,7 +388,7 @@ def decode_file(data: bytes) -> tuple[list[list[Command]], np.ndarray, dict]:
     cols[, 3]) by the encoder's integer simulation, and emission statistics."""
     lay, C = read_coefficients(data)
     streams, pix = [], []
-    st = {"spline_lines": 0, "rle_lines": 0, "knots": 0}
+    st = dict.fromkeys(STATS, 0)
     for c in range(C.shape[0]):
         cm, px, s = channel_commands(C[c], lay)
         streams.append(cm)
