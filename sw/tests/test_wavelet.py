@@ -207,3 +207,26 @@ def test_bad_files_are_rejected():
         WV.read_coefficients(data[:-1])
     with pytest.raises(WV.WaveletError):
         WV.encode_file(np.zeros((4, 4)), 0.0)
+
+
+# ---- the fetched photographs: checksum, no network needed ------------------------------------
+
+
+def test_fetch_photo_checks_the_checksum(tmp_path, monkeypatch):
+    import zipfile
+
+    from diffengine.bench import recon_images as RI
+
+    member, digest, _ = RI.PHOTOS["camera"]
+    # a cached wheel whose camera.png is not the published one: rejected, not used
+    with zipfile.ZipFile(tmp_path / "scikit_image-0.26.0-cp311-none-any.whl", "w") as z:
+        z.writestr(member, b"not the photograph")
+    with pytest.raises(RI.FetchError, match="SHA-256"):
+        RI.fetch_photo("camera", tmp_path)
+    assert not (tmp_path / "camera.png").exists()
+    # a cached file with the right digest is used as it is (sha256 stubbed to the digest)
+    (tmp_path / "camera.png").write_bytes(b"stand-in")
+    monkeypatch.setattr(RI, "_sha256", lambda p: digest)
+    assert RI.fetch_photo("camera", tmp_path) == tmp_path / "camera.png"
+    with pytest.raises(RI.FetchError, match="unknown photograph"):
+        RI.fetch_photo("lena", tmp_path)

@@ -203,6 +203,10 @@ def configure(ap) -> None:
                     + ", fetched on demand)")
     ap.add_argument("--wavelet-cache", help="pickle of the wavelet measurements: written "
                     "after a run, read instead of measuring if it exists")
+    ap.add_argument("--wavelet-rtl", default=None, nargs="?", const=",".join(RW.RTL_IMAGES),
+                    help="also decode whole 640x480 frames of these images through the "
+                    "Verilated display controller (72 chips; ~2 min each; default "
+                    + ",".join(RW.RTL_IMAGES) + ")")
     ap.set_defaults(func=command)
 
 
@@ -230,8 +234,20 @@ def _wavelet(args) -> int:
         except RI.FetchError as e:
             print(f"diffengine bench recon: error: {e}", file=sys.stderr)
             return 2
-        if cache:
-            cache.write_bytes(pickle.dumps(res))
+    if args.wavelet_rtl:
+        rtl = []
+        for n in args.wavelet_rtl.split(","):
+            try:
+                x = res[n]["x"] if n in res else RW.load(n, ROOT)[0]
+                rtl.append(RW.rtl_frame(n, x))
+            except (RI.FetchError, ValueError) as e:
+                print(f"diffengine bench recon: error: {e}", file=sys.stderr)
+                return 2
+            print(f"wavelet RTL {n}: identical {rtl[-1]['rtl_eq_model']}, "
+                  f"{rtl[-1]['secs']:.0f} s", flush=True)
+        res["_rtl"] = rtl
+    if cache:
+        cache.write_bytes(pickle.dumps(res))
     IMG.mkdir(parents=True, exist_ok=True)
     for n in names:
         RW.plot(n, res[n], IMG / f"recon_wavelet_{n}.png", PER_LINE, FRAME_LINES)
