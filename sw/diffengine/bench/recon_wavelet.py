@@ -244,6 +244,11 @@ def section(res: dict, names, per_line: int, img_dir_rel: str = "img") -> list[s
     a("`encode/entropy.py`; this section: `diffengine bench recon --wavelet-only`")
     a("(`bench/recon_wavelet.py`); tests: `sw/tests/test_wavelet.py` (round trips, random")
     a("with printed seeds) and `sw/tests/test_wavelet_rtl.py` (Verilated display controller).")
+    a("The seed's Fig. 7.28 is lost from the text; its caption: \"Reconstruction of a wavelet")
+    a("encoded image (simulated). The multi resolution description is transformed directly")
+    a("into instructions for the Difference Engine.\" Ours is not simulated at the")
+    a("functional level only: the `*_decoded.png` crops below are the golden model's")
+    a("pixels of the commands, and whole frames go through the RTL (further down).")
     a("")
     a("* **Transform:** CDF (2,2) biorthogonal spline wavelet (5/3): synthesis scaling")
     a("  function = linear B-spline (hat), so every synthesised scanline is piecewise linear")
@@ -270,7 +275,7 @@ def section(res: dict, names, per_line: int, img_dir_rel: str = "img") -> list[s
     a("* **Entropy coding:** adaptive binary range coding (`constriction` 0.5.0, MIT OR")
     a("  Apache-2.0): significance with a 9-class causal neighbourhood context per band,")
     a("  magnitudes as adaptive unary bit length + raw mantissa, raw signs; KT estimates per")
-    a("  context. The rate is the whole file (a 20-byte header + range-coded words).")
+    a("  context. The rate is the whole file (a 19-byte header + range-coded words).")
     a("* **JPEG:** OpenImageIO, 8 bits, 4:4:4, at the smallest quality whose PSNR reaches the")
     a("  wavelet point's (JPEG bytes and PSNR shown); the ratio uses JPEG's bytes at exactly")
     a("  the wavelet's PSNR, log-linear between qualities q-1 and q. 8-bit JPEG cannot go")
@@ -281,7 +286,7 @@ def section(res: dict, names, per_line: int, img_dir_rel: str = "img") -> list[s
     a("  by SHA-256 (`diffengine bench recon-images --photos`; not shipped).")
     a("")
     a("| image | delta | file bytes | PSNR dB | JPEG q | JPEG bytes | wavelet / JPEG bytes | "
-      "instr./frame | max/line | px by Eval2 | decode s |")
+      "instr./frame (per colour) | max/line | px by Eval2 | decode s |")
     a("|---|---|---|---|---|---|---|---|---|---|---|")
     ratios = {}
     for n in names:

@@ -28,10 +28,11 @@ is where the second difference of r is nonzero (numerically: |Δ²r| > KNOT_TOL)
 spline.quantise turns it into an exact 12.24 Eval2 + SetdI program whose pixels are
 round(r) (the +0.5 of the truncation), Eval0 patches where round(r) leaves 0..4095 (the
 array wraps, no saturation) or, rarely, where r is within 2^-24 of a half, so that the
-array's pixels equal the floating-point decoder's clip(round(r)) exactly. Where fine
-detail makes knots dense, that line costs more than its Eval0 run-length raster of the
-same pixels; such a line is sent as that raster (`rle` lines, counted in the results) -
-same pixels, fewer instructions.
+array's pixels equal the floating-point decoder's clip(round(r)) exactly. A knot costs
+2 slots, an Eval2 4 and an Eval0 run 1, so where fine detail makes knots dense the same
+pixels are cheaper as Eval0 runs: each line is cut into Eval2 segments (with their own
+knots) and Eval0 runs by an exact dynamic programme over the segment ends
+(`segment_plan`, O(W)) - same pixels, fewest instructions of the two forms mixed.
 
 `decode_file` is the receiver: file -> commands (three lists for colour); the pixels
 are the golden model's (functional.render) output of those commands.
