@@ -15,13 +15,16 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: view gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
 	@echo "                 controller (3 x 72 chips) and golden model -> out/demo.png, PSNR"
 	@echo "                 (SCENE=file.scene CHIPS=72 THREADS=1 RTL=0 for model only;"
 	@echo "                 first run builds the model: ~1-1.5 min on 2 cores; the RTL frame ~35 s)"
+	@echo "make view        interactive viewer on http://127.0.0.1:PORT/ (default 8765): pick, drag,"
+	@echo "                 opacity, light, undo, statistics (SCENE=... default the CAD scene;"
+	@echo "                 SCENE=sw/scenes/teapot/teapot_box.scene; docs/viewer.md)"
 	@echo "make anim        the shipped animation through incremental frame deltas -> out/anim"
 	@echo "make demo-cmd    one command file through the golden model (DEMO_FILE=...)"
 	@echo "make test        run every test (sets itself up on first use)"
@@ -32,7 +35,7 @@ help:
 	@echo "make test-quality the outlier gate at full size: shipped scenes + public meshes (sw/scenes/meshes)"
 	@echo "make bench       golden model speed, y-processor commands per line and host time"
 	@echo "                 (docs/performance.md)"
-	@echo "make bench-hsr   HSR benchmarks (Table 5.2, Fig 5.30) into docs/performance.md"
+	@echo "make bench-hsr   HSR benchmarks (Fig 5.30, move; Table 5.2, Figs 5.13-5.18) into docs/performance.md"
 	@echo "make bench-array Verilated array speed (1/8/72 chips) vs the models"
 	@echo "make bench-span  span-serial array: clocks per line on the teapot and CAD frames"
 	@echo "make waves TEST=<cocotb test> [PE=p] [BUG=0|1]"
@@ -68,6 +71,14 @@ ANIM ?= sw/scenes/anim/cad_drag.anim
 anim: $(SETUP)
 	$(ENV) $(DE) anim --anim $(ANIM) --out $(OUT)/anim
 
+# The interactive viewer (docs/viewer.md): SCENE given on the command line, else the CAD scene.
+VIEW_SCENE := $(if $(filter command line environment,$(origin SCENE)),$(SCENE),sw/scenes/cad/cad.scene)
+PORT ?= 8765
+view: $(SETUP)
+	@./scripts/ensure_system.sh
+	@$(MAKE) -s -C sw/yproc build/yproc
+	$(ENV) $(DE) view --scene $(VIEW_SCENE) --port $(PORT)
+
 # One command file through the golden model (the first demo, before the pipeline).
 demo-cmd: $(SETUP)
 	@mkdir -p $(OUT)
@@ -92,6 +103,7 @@ test-c:
 	@./scripts/ensure_system.sh
 	$(MAKE) -C sw/hsr test
 	$(MAKE) -C sw/yproc test
+	$(MAKE) -C sw/fmodel test
 	$(MAKE) -C sw/hsr/fuzz smoke
 
 # Coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang; FUZZ_SECONDS each).
@@ -149,9 +161,11 @@ fpga: $(SETUP)
 
 bench-hsr: $(SETUP)
 	$(ENV) $(DE) bench hsr --write $(BENCH_ARGS)
+	$(ENV) $(DE) bench table52 --write
 
 bench: $(SETUP)
 	$(ENV) $(DE) bench model --write
+	$(ENV) $(DE) bench model --fast --write
 	$(ENV) $(DE) bench yproc --write
 
 # QUICK=1: the 72-chip rates (and the baseline's, when built) and the stream only.
@@ -168,7 +182,7 @@ postsynth: $(SETUP)
 	$(MAKE) -C fpga postsynth
 
 clean:
-	rm -rf $(OUT) build sim/out sim/build sw/hsr/build sw/yproc/build fpga/build
+	rm -rf $(OUT) build sim/out sim/build sw/hsr/build sw/yproc/build sw/fmodel/build fpga/build
 	find tb -name 'sim_build*' -prune -exec rm -rf {} +
 	rm -f tb/de_array/coverage_*.txt tb/de_array/seed_*.txt
 	git worktree prune 2>/dev/null || true

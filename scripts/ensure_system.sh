@@ -37,7 +37,8 @@ DEFAULT=(
   liblz4-dev        # Verilator FST traces (scripts/ensure_fst.sh)
   zlib1g-dev        # Verilator FST traces
   gtkwave           # fst2vcd in the trace tests, GTKWave for make waves
-  chromium          # tb/sim_regress/test_inspect.py (headless)
+  chromium          # tb/sim_regress/test_inspect.py, the viewer's browser tests (headless)
+  chromium-driver   # Selenium's chromedriver for the viewer's browser tests (docs/viewer.md)
   'ccache?'         # faster Verilator rebuilds
 )
 

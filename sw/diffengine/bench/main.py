@@ -11,13 +11,15 @@ BENCHES = [
     ("model", ".model", "golden model speed (functional and structural)"),
     ("yproc", ".yproc", "y-processor: commands per line, host time; --scaling: time "
      "against triangle count"),
-    ("hsr", ".hsr", "hidden-surface removal: Table 5.2, Fig. 5.30, incremental move"),
+    ("hsr", ".hsr", "hidden-surface removal: Fig. 5.30, incremental move"),
+    ("table52", ".table52", "Grid-List efficiency (Table 5.2) and Figs. 5.13-5.18 on the six scenes"),
     ("hsr-incr", ".hsr_incr", "incremental HSR against a full build: teapot + box, 10-10,000 parts, "
      "the CAD drag, against --baseline-rev"),
     ("array", ".array", "Verilated array speed (1/8/72 chips) against the baseline revision"),
     ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames"),
     ("recon", ".recon", "image reconstruction report -> docs/reconstruction.md"),
     ("recon-images", ".recon_images", "the reconstruction test images -> sw/images"),
+    ("viewer", ".viewer", "viewer: pointer-to-frame latency of a scripted drag (teapot, CAD)"),
     ("render", ".render", "docs/performance.md sections from docs/bench/*.json"),
 ]
 

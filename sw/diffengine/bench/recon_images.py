@@ -27,10 +27,21 @@ that "piecewise linear on the 12-bit grid" survives storage.
 The teapot images need the C y-processor (built by `make -C sw/hsr` on demand by
 demo.py, ~25 s); `--synthetic-only` skips them.
 
-Usage: diffengine bench recon-images [--out sw/images] [--synthetic-only]
+Natural photographs (fetched on demand, not shipped, `fetch_photo`): no network but the
+package registries is reachable here, so the Kodak set cannot be fetched; the photos
+come from the scikit-image wheel on PyPI (`pip download scikit-image==0.26.0
+--no-deps`), which ships them in skimage/data/, and are checked by SHA-256 after
+extraction (the wheel itself differs per platform). Licences (skimage/data/_fetchers.py):
+
+  camera  512x512 grey, "No copyright restrictions. CC0 by the photographer (Lav Varshney)."
+  coffee  600x400 RGB, "No copyright restrictions. CC0 by the photographer (Rachel
+          Michetti)." (courtesy of Pikolo Espresso Bar)
+
+Usage: diffengine bench recon-images [--out sw/images] [--synthetic-only] [--photos]
 """
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import OpenImageIO as oiio  # noqa: I001  (imported before numpy: see write_png)
@@ -213,14 +224,79 @@ def write_png(path: Path, v12: np.ndarray) -> None:
         raise SystemExit(f"cannot write {path}: {buf.geterror()}")
 
 
+SKIMAGE = "scikit-image==0.26.0"
+PHOTOS = {
+    "camera": ("skimage/data/camera.png",
+               "b0793d2adda0fa6ae899c03989482bff9a42d3d5690fc7e3648f2795d730c23a",
+               "CC0, photographer Lav Varshney (scikit-image 0.26.0 skimage/data)"),
+    "coffee": ("skimage/data/coffee.png",
+               "cc02f8ca188b167c775a7101b5d767d1e71792cf762c33d6fa15a4599b5a8de7",
+               "CC0, photographer Rachel Michetti (scikit-image 0.26.0 skimage/data)"),
+}
+PHOTO_CACHE = REPO / "build" / "photos"
+
+
+class FetchError(RuntimeError):
+    """A photograph could not be fetched or failed its checksum."""
+
+
+def _sha256(path: Path) -> str:
+    import hashlib
+
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def fetch_photo(name: str, cache: Path = PHOTO_CACHE) -> Path:
+    """Path of a checked natural photograph, downloading the wheel that holds it if the
+    cache lacks it (pip, PyPI). Raises FetchError (with pip's message) without network."""
+    import subprocess
+    import sys
+    import zipfile
+
+    if name not in PHOTOS:
+        raise FetchError(f"unknown photograph {name!r} (one of {', '.join(PHOTOS)})")
+    member, digest, _ = PHOTOS[name]
+    out = Path(cache) / f"{name}.png"
+    if out.is_file() and _sha256(out) == digest:
+        return out
+    Path(cache).mkdir(parents=True, exist_ok=True)
+    wheels = sorted(Path(cache).glob("scikit_image-0.26.0-*.whl"))
+    if not wheels:
+        print(f"fetching {SKIMAGE} (wheel, ~14 MB) for {name}.png ...", file=sys.stderr)
+        res = subprocess.run([sys.executable, "-m", "pip", "download", SKIMAGE, "--no-deps",
+                              "--only-binary", ":all:", "-d", str(cache)],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        wheels = sorted(Path(cache).glob("scikit_image-0.26.0-*.whl"))
+        if res.returncode or not wheels:
+            raise FetchError(f"{cache}: pip download {SKIMAGE} failed (no network?):\n"
+                             + res.stdout[-1500:])
+    with zipfile.ZipFile(wheels[0]) as z:
+        out.write_bytes(z.read(member))
+    got = _sha256(out)
+    if got != digest:
+        out.unlink()
+        raise FetchError(f"{wheels[0]}:{member}: SHA-256 {got}, expected {digest}")
+    return out
+
+
 def configure(ap) -> None:
     """The arguments of this subcommand (the `diffengine` tree calls this)."""
     ap.add_argument("--out", default=str(REPO / "sw" / "images"))
     ap.add_argument("--synthetic-only", action="store_true", help="skip the teapot frames")
+    ap.add_argument("--photos", action="store_true", help="only fetch and check the natural "
+                    f"photographs into {PHOTO_CACHE} (not shipped: CC0, from {SKIMAGE})")
     ap.set_defaults(func=command)
 
 
 def command(args) -> int:
+    if args.photos:
+        try:
+            for name in PHOTOS:
+                print(f"{fetch_photo(name)}: SHA-256 ok, licence {PHOTOS[name][2]}")
+        except FetchError as e:
+            print(f"diffengine bench recon-images: error: {e}", file=sys.stderr)
+            return 2
+        return 0
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for name, fn in IMAGES.items():

@@ -19,12 +19,15 @@ DOC = REPO / "docs" / "performance.md"
 # section -> (module, function) whose function(record) -> the section's markdown
 SECTIONS = {
     "model": (".model", "render"),
+    "model-fast": (".model", "render_fast"),
     "hsr": (".hsr", "render"),
     "hsr-incr": (".hsr_incr", "render"),
+    "table52": (".table52", "render"),
     "array": (".array", "render"),
     "yproc": (".yproc", "render"),
     "yproc-scaling": (".yproc", "render_scaling"),
     "span": (".span", "render"),
+    "viewer": (".viewer", "render"),
 }
 
 

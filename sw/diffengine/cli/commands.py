@@ -113,6 +113,9 @@ def _renderer(level: str):
     if level == "functional":
         from ..model import functional
         return functional.render
+    if level == "fast":
+        from ..model import fast
+        return fast.render
     try:
         from ..model import structural
     except ImportError:

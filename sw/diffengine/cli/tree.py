@@ -1,7 +1,7 @@
 """The `diffengine` command: one argparse subcommand tree (docs/formats.md).
 
     diffengine asm | disasm | model | plot | compare | capacity | encode | reference |
-               frame | trace | inspect | sim | demo | anim | bench NAME   [-h]
+               frame | trace | inspect | sim | demo | anim | view | bench NAME   [-h]
 
 The small subcommands' handlers are in cli.commands; a larger subcommand keeps its
 arguments next to its code (`configure(parser)` sets `func`, the handler). User errors
@@ -32,6 +32,8 @@ MODULES = [
      "and golden model -> PNGs, PSNR"),
     ("anim", "..pipeline.anim", "make anim: incremental frame deltas -> PNGs and a GIF, "
      "every frame checked against its full re-render"),
+    ("view", "..viewer.server", "make view: the interactive viewer on 127.0.0.1 (pick, drag, "
+     "opacity, light, undo; per-frame statistics; docs/viewer.md)"),
     ("bench", "..bench.main", "benchmarks -> out/bench/NAME.json, and the "
      "docs/performance.md tables rendered from them"),
 ]
@@ -88,7 +90,9 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("input", help="command file, .de48 or .de32")
         s.add_argument("-o", "--output", required=True)
         s.add_argument("--width", type=int, default=640, help="columns (PEs), default 640")
-        s.add_argument("--level", choices=["functional", "structural"], default="functional")
+        s.add_argument("--level", choices=["functional", "structural", "fast"], default="functional",
+                       help="functional (numpy, the reference; default), structural (cycle "
+                            "level) or fast (the C functional model, sw/fmodel)")
         s.add_argument("--carry-bug", action="store_true", help="model the §7.7 adder fault")
         s.add_argument("--compensate", action="store_true",
                        help="apply the mapper's carry-bug compensation to intensities")

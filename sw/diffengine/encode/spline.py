@@ -418,17 +418,23 @@ def _patch(p: LineProgram, target: np.ndarray, lam: float) -> None:
     pix = p.pixels()
     err = pix - target
     bad = (err != 0) & ((err.astype(float) ** 2 >= lam) | (np.abs(err) > 2047))
-    p.patches = []
+    p.patches = patch_runs(bad, target)
+
+
+def patch_runs(bad: np.ndarray, target: np.ndarray) -> list[tuple[int, int, int]]:
+    """Eval0 patches (x, dx, pixel): one per run of flagged pixels with equal targets."""
+    out = []
     i, n = 0, len(target)
     while i < n:
         if bad[i]:
             j = i + 1
             while j < n and bad[j] and target[j] == target[i]:
                 j += 1
-            p.patches.append((i, j - i, int(target[i])))
+            out.append((i, j - i, int(target[i])))
             i = j
         else:
             i += 1
+    return out
 
 
 BASES = ("knots", "coefficient", "choice")

@@ -19,16 +19,22 @@ class YprocError(RuntimeError):
     """yproc could not be built, or refused its input (the message names file and line)."""
 
 
-def build() -> Path:
-    """Build sw/yproc/build/yproc if it is out of date; returns its path."""
-    lock = Path(tempfile.gettempdir()) / "hsr_yproc_build.lock"
+def make_locked(directory: Path, target: str, lock_name: str) -> subprocess.CompletedProcess:
+    """`make -s -C directory target` under a file lock in the temporary folder, so that
+    parallel pytest workers and make never build the same C target together."""
+    lock = Path(tempfile.gettempdir()) / lock_name
     with open(lock, "w") as fh:
         fcntl.flock(fh, fcntl.LOCK_EX)
         try:
-            r = subprocess.run(["make", "-s", "-C", str(YPROC_DIR), "build/yproc"],
-                               capture_output=True, text=True)
+            return subprocess.run(["make", "-s", "-C", str(directory), target],
+                                  capture_output=True, text=True)
         finally:
             fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def build() -> Path:
+    """Build sw/yproc/build/yproc if it is out of date; returns its path."""
+    r = make_locked(YPROC_DIR, "build/yproc", "hsr_yproc_build.lock")
     if r.returncode or not YPROC.exists():
         raise YprocError("cannot build sw/yproc/build/yproc:\n" + r.stdout + r.stderr)
     return YPROC

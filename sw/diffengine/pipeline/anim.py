@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import REPO, isa
 from ..formats import binfmt, frame
-from ..model import functional
+from ..model import fast, functional
 from .demo import build_yproc
 
 Line = list[bytes]   # the 6-byte words of one line, its Refresh last
@@ -96,12 +96,14 @@ def to_de48(lines: list[bytes]) -> bytes:
 COMMAND_HELP = """yproc anim (HSR move / opacity / light changes, then re-scan of the damaged lines only)
 writes frame 0's r/g/b.de48 streams and one frame delta per later frame (docs/yproc.md
 section 6). This script applies the deltas in order, re-renders only the changed lines
-with the golden model, and writes every frame as an 8-bit PNG and the sequence as an
-animated GIF. yproc itself re-renders every frame in full and compares the streams
-(its `frames_differing_from_full` must be 0, checked here); this script also checks that
-the image updated line by line equals a from-scratch golden render of the last frame.
+with the golden model (the C functional model, sw/fmodel; --model numpy for the numpy
+one), and writes every frame as an 8-bit PNG and the sequence as an animated GIF. yproc
+itself re-renders every frame in full and compares the streams (its
+`frames_differing_from_full` must be 0, checked here); this script also checks that the
+image updated line by line equals a from-scratch render of the last frame by the numpy
+golden model (diffengine.model.functional, the reference).
 
-    diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim]
+    diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim] [--model fast|numpy]
 
 Exit status 0 only if no frame differs from its full re-render.
 """
@@ -118,6 +120,9 @@ def configure(ap) -> None:
     ap.epilog = COMMAND_HELP
     ap.add_argument("--anim", default=str(REPO / "sw/scenes/anim/cad_drag.anim"))
     ap.add_argument("--out", default=str(REPO / "out" / "anim"))
+    ap.add_argument("--model", choices=("fast", "numpy"), default="fast",
+                    help="golden model of the changed lines: fast = the C functional model "
+                         "(default), numpy = diffengine.model.functional")
     ap.set_defaults(func=command)
 
 
@@ -148,8 +153,11 @@ def command(a) -> int:
                 changed = list(range(len(chans[c])))
             else:
                 changed = [y for y in range(len(chans[c])) if chans[c][y] != seq[f - 1][c][y]]
-            if changed:
+            if changed and a.model == "numpy":
                 img[changed, :, c] = render_lines([chans[c][y] for y in changed], W)
+            elif changed:
+                fast.render_lines(img, [{y: chans[c][y] for y in changed} if k == c else {}
+                                        for k in range(3)])
         frame.write_png8(out / f"frame{f:03d}.png", img)
         pics.append(frame.view8(img).copy())
         done = f + 1
@@ -158,8 +166,10 @@ def command(a) -> int:
             print(f"\r  golden model, changed lines only [{bar:<30}] {done}/{len(seq)}", end="", flush=True)
         elif done % 6 == 0 or done == len(seq):
             print(f"  golden model, changed lines only: {done}/{len(seq)} frames", flush=True)
-    print(f"{'' if not sys.stdout.isatty() else chr(10)}  golden model: {time.time() - t1:.1f} s")
+    print(f"{'' if not sys.stdout.isatty() else chr(10)}  golden model ({a.model}, changed "
+          f"lines only) and PNG/GIF frames: {time.time() - t1:.1f} s")
     # the image updated line by line == the last frame's streams rendered from scratch
+    # by the numpy reference model
     full = np.stack([render_lines(seq[-1][c], W) for c in range(3)], axis=-1)
     pixel_ok = bool((full == img).all())
     try:

@@ -2,7 +2,8 @@
 
   scene + OBJ --yproc scan (HSR + scan conversion + shading, C)--> r/g/b.de48
      --> Verilated display_controller (sim/dc, 3 x NumChips chips)  --> RTL frame (PNG)
-     --> golden model (diffengine.model.functional, per colour)           --> must equal the RTL
+     --> golden model (diffengine.model.fast, the C model, all three colours; --model numpy:
+         diffengine.model.functional, the numpy reference it is tested equal to) --> must equal the RTL
      --> numpy reference renderer (16x16 Phong, diffengine.model.reference) --> PSNR
 
 `run()` does all of it and returns a report dict; `command()` is its command line (`diffengine demo`, make demo).
@@ -25,7 +26,7 @@ import numpy as np
 from .. import REPO, isa
 from ..formats import binfmt, frame
 from ..host import yproc
-from ..model import functional, reference
+from ..model import fast, functional, reference
 from ..rtl import dc_harness
 
 YPROC = yproc.YPROC
@@ -148,9 +149,24 @@ def yproc_scan(scene: Path, outdir: Path, aa: bool = True, shading: str | None =
     return st
 
 
+MODELS = ("fast", "numpy")
+
+
 def golden(paths, width: int, height: int, carry_bug: bool = False,
-           progress=None) -> np.ndarray:
-    """The golden model frame (H, W, 3) uint16 from three .de48 streams."""
+           progress=None, model: str = "fast") -> np.ndarray:
+    """The golden model frame (H, W, 3) uint16 from three .de48 streams: model "fast" is
+    the C functional model (diffengine.model.fast, milliseconds), "numpy" the numpy
+    reference (diffengine.model.functional) that sw/tests/test_fmodel.py proves it equal to."""
+    if model == "fast":
+        try:
+            out = fast.render_frame(paths, width, height, carry_bug)
+        except fast.FastModelError as e:
+            raise PipelineError(str(e)) from None
+        if progress:
+            progress(1, 1)
+        return out
+    if model != "numpy":
+        raise PipelineError(f"unknown golden model {model!r} (one of {', '.join(MODELS)})")
     out = np.zeros((height, width, 3), dtype=np.uint16)
     streams = []
     for p in paths:
@@ -211,7 +227,7 @@ def _reference_cached(scene: Path, cache_dir: Path, samples: int = 16, progress=
 def run(scene, outdir, chips: int = 72, threads: int = 1, rtl: bool = True,
         aa: bool = True, shading: str | None = None, num_buf: int = 1,
         show_progress: bool = True, log=print, ref_samples: int = 16,
-        png_name: str = "demo") -> dict:
+        png_name: str = "demo", model: str = "fast") -> dict:
     """The whole pipeline; returns the report (also written to OUTDIR/<png_name>_report.json).
 
     Raises PipelineError on a failed stage; the report's 'bit_identical' and 'psnr_db'
@@ -253,9 +269,10 @@ def run(scene, outdir, chips: int = 72, threads: int = 1, rtl: bool = True,
 
     pb = Progress("golden", show_progress)
     t = time.monotonic()
-    gold = golden(paths, W, H, progress=pb)
+    gold = golden(paths, W, H, progress=pb, model=model)
     pb.close()
-    stage("golden model (functional)", time.monotonic() - t)
+    stage(f"golden model ({'C, fmodel' if model == 'fast' else 'numpy'})", time.monotonic() - t)
+    rep["golden_model"] = model
 
     if rtl:
         cfg = dc_harness.Config(chips=chips, num_buf=num_buf, threads=threads, test=test)
@@ -357,6 +374,9 @@ def configure(ap) -> None:
                     help="yproc scan --shading (default: the scene's)")
     ap.add_argument("--num-buf", type=int, default=1,
                     help="y-processors (buffers per colour); lines are dealt round-robin")
+    ap.add_argument("--model", choices=MODELS, default="fast",
+                    help="golden model: fast = the C functional model (sw/fmodel, default), "
+                         "numpy = the numpy reference it is tested equal to")
     ap.add_argument("--min-psnr", type=float, default=MIN_PSNR)
     ap.add_argument("--max-outliers", type=int, default=0,
                     help="fail above this many outlier pixels (error > 0.15 of full scale "
@@ -368,7 +388,7 @@ def command(a) -> int:
     try:
         rep = run(a.scene, a.out, chips=a.chips, threads=a.threads,
                            rtl=not a.no_rtl, aa=not a.no_aa, shading=a.shading,
-                           num_buf=a.num_buf)
+                           num_buf=a.num_buf, model=a.model)
     except (PipelineError, RuntimeError, OSError, ValueError) as e:
         print(f"demo: error: {e}", file=sys.stderr)
         return 1

@@ -10,7 +10,15 @@
  *       empty cells addressed (counted as memory accesses, as footnote 10 of
  *       section 5.3.3 does) and extents actually overlapping, summed over all
  *       queries, and mean_ratio: the mean over queries with at least one
- *       overlap of (entries + empty cells) / overlaps.
+ *       overlap of (entries + empty cells) / overlaps.  Also: cells = cells
+ *       addressed; passed = entries with right+top >= Q.left+Q.bot (entries
+ *       minus the ones that stop a list: what the sorted lists force any scan
+ *       of those cells to visit); seed_entries / seed_empty / seed_mean_ratio
+ *       = the same counts for the cell range of the loops of section 5.3.2
+ *       started ceil((w_Q + w_max) m / X) columns before the one holding
+ *       Q.right (rows likewise), a superset of ours.  Each query's entries are
+ *       recounted from independent sorted copies of the cell lists and must
+ *       equal hsr_gridlist_query's count (else exit 1).
  *   hsr_bench hsr SCENE [REPEAT]
  *       Builds the scene (projection + incremental HSR of every face, in
  *       order) REPEAT times; prints faces, visible domains, best seconds.
@@ -72,6 +80,28 @@ static int usage(void)
 static void count_cb(int id, void *ctx) { (void)id; (*(long *)ctx)++; }
 
 /* ---- grid: Table 5.2 ------------------------------------------------ */
+typedef struct { int cell; int64_t key; } cellkey;
+
+static int cellkey_cmp(const void *a, const void *b)
+{
+    const cellkey *x = a, *y = b;
+    if (x->cell != y->cell) return x->cell < y->cell ? -1 : 1;
+    return x->key > y->key ? -1 : x->key < y->key;      /* decreasing key */
+}
+
+/* entries of one cell list (keys decreasing) a scan stopping at key < k visits:
+ * those with key >= k (*ge) and, if the list goes on, the one that stops it */
+static long cell_visits(const int64_t *keys, int n, int64_t k, long *ge)
+{
+    int lo = 0, hi = n;                 /* first index with key < k */
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (keys[mid] >= k) lo = mid + 1; else hi = mid;
+    }
+    *ge = lo;
+    return lo + (lo < n);
+}
+
 static int cmd_grid(int argc, char **argv)
 {
     if (argc < 7) return usage();
@@ -79,61 +109,107 @@ static int cmd_grid(int argc, char **argv)
     if (!f) { perror(argv[2]); return 1; }
     int64_t W = atoll(argv[3]), Q = atoll(argv[4]);
     int nq = atoi(argv[5]);
-    int n = 0, cap = 1024;
+    if (W < 1 || Q < 0 || nq < 1) { fprintf(stderr, "%s: bad W, SIZE or NQ\n", argv[0]); fclose(f); return 2; }
+    int n = 0, cap = 1024, line = 0;
     hsr_extent *e = malloc(sizeof *e * (size_t)cap);
-    long long l, b, r, t;
-    while (fscanf(f, "%lld %lld %lld %lld", &l, &b, &r, &t) == 4) {
-        if (n == cap) { cap *= 2; e = realloc(e, sizeof *e * (size_t)cap); }
-        if (!e) { fclose(f); return 1; }
+    char buf[256];
+    while (e && fgets(buf, sizeof buf, f)) {
+        long long l, b, r, t;
+        line++;
+        if (sscanf(buf, "%lld %lld %lld %lld", &l, &b, &r, &t) != 4 || r < l || t < b) {
+            fprintf(stderr, "%s:%d: expected \"left bot right top\" with left <= right, bot <= top\n", argv[2], line);
+            fclose(f); free(e); return 1;
+        }
+        if (n == cap) {
+            cap *= 2;
+            hsr_extent *ne = realloc(e, sizeof *e * (size_t)cap);
+            if (!ne) { free(e); e = NULL; break; }
+            e = ne;
+        }
         e[n++] = (hsr_extent){l, b, r, t};
     }
     fclose(f);
+    if (!e) { fprintf(stderr, "out of memory\n"); return 1; }
     int64_t wmax = 0, hmax = 0;
     for (int i = 0; i < n; i++) {
         if (e[i].right - e[i].left > wmax) wmax = e[i].right - e[i].left;
         if (e[i].top - e[i].bot > hmax) hmax = e[i].top - e[i].bot;
     }
     hsr_extent win = {0, 0, W, W};
+    cellkey *ck = malloc(sizeof *ck * (size_t)(n ? n : 1));
+    int64_t *keys = malloc(sizeof *keys * (size_t)(n ? n : 1));
+    if (!ck || !keys) { free(e); free(ck); free(keys); fprintf(stderr, "out of memory\n"); return 1; }
     for (int a = 6; a < argc; a++) {
         int m = atoi(argv[a]);
         hsr_gridlist *g;
         if (hsr_gridlist_create(win, m, m, &g) != HSR_OK) { fprintf(stderr, "bad grid %d\n", m); return 1; }
-        /* cell occupancy, same cell rule as gridlist.c (cell of (left, bot)) */
+        /* An independent copy of every cell's list (same cell rule as gridlist.c: the
+         * cell of (left, bot), cells ceil(W/m) wide, border cells take what lies
+         * outside), as sorted key arrays: it counts what a scan of any cell range
+         * visits, so the real query's count can be checked and other ranges tried. */
         int64_t cw = (W + m - 1) / m, ch = cw;
-        int *occ = calloc((size_t)m * (size_t)m, sizeof(int));
 #define COL(x) ((x) < 0 ? 0 : ((x) / cw >= m ? m - 1 : (int)((x) / cw)))
 #define ROW(y) ((y) < 0 ? 0 : ((y) / ch >= m ? m - 1 : (int)((y) / ch)))
+        int *start = calloc((size_t)m * (size_t)m + 1, sizeof(int));
+        if (!start) { fprintf(stderr, "out of memory\n"); return 1; }
         for (int i = 0; i < n; i++) {
             if (hsr_gridlist_insert(g, i, e[i]) != HSR_OK) { fprintf(stderr, "insert failed\n"); return 1; }
-            occ[ROW(e[i].bot) * m + COL(e[i].left)]++;
+            ck[i] = (cellkey){ROW(e[i].bot) * m + COL(e[i].left), e[i].right + e[i].top};
         }
-        long long entries = 0, empty = 0, over = 0, nhit = 0;
-        double ratio_sum = 0;   /* mean over queries with >= 1 overlap of addressed / overlaps */
+        qsort(ck, (size_t)n, sizeof *ck, cellkey_cmp);
+        for (int i = 0; i < n; i++) { keys[i] = ck[i].key; start[ck[i].cell + 1]++; }
+        for (int c = 0; c < m * m; c++) start[c + 1] += start[c];
+        /* seed: the loops of section 5.3.2 started ceil((w_Q + w_max) m / X) columns
+         * (rows) before the one holding Q.right (Q.top), i.e. that many + 1 */
+        int dc = (int)(((Q + wmax) * m + W - 1) / W), dr = (int)(((Q + hmax) * m + W - 1) / W);
+        long long entries = 0, empty = 0, over = 0, nhit = 0, cells = 0, passed = 0;
+        long long s_entries = 0, s_empty = 0;
+        double ratio_sum = 0, s_ratio_sum = 0;   /* mean over queries with >= 1 overlap */
         double t0 = now();
         for (int qy = 0; qy < nq; qy++)
             for (int qx = 0; qx < nq; qx++) {
                 int64_t cx = (int64_t)((qx + 0.5) * (double)W / nq), cy = (int64_t)((qy + 0.5) * (double)W / nq);
                 hsr_extent q = {cx - Q / 2, cy - Q / 2, cx - Q / 2 + Q, cy - Q / 2 + Q};
-                long hits = 0, qe = 0;
+                long hits = 0;
                 long vis = hsr_gridlist_query(g, q, count_cb, &hits);
-                entries += vis;
-                over += hits;
                 int c0 = COL(q.left - wmax), c1 = COL(q.right), r0 = ROW(q.bot - hmax), r1 = ROW(q.top);
-                for (int rr = r0; rr <= r1; rr++)
-                    for (int cc = c0; cc <= c1; cc++) qe += occ[rr * m + cc] == 0;
-                empty += qe;
-                if (hits > 0) { ratio_sum += (double)(vis + qe) / (double)hits; nhit++; }
+                int sc0 = c1 - dc < 0 ? 0 : c1 - dc, sr0 = r1 - dr < 0 ? 0 : r1 - dr;
+                int64_t k = q.left + q.bot;
+                long qv = 0, qe = 0, qp = 0, sv = 0, se = 0;
+                for (int rr = sr0; rr <= r1; rr++)
+                    for (int cc = sc0; cc <= c1; cc++) {
+                        int c = rr * m + cc, len = start[c + 1] - start[c];
+                        long ge, v = len ? cell_visits(keys + start[c], len, k, &ge) : 0;
+                        int in = rr >= r0 && cc >= c0;
+                        if (len) { sv += v; if (in) { qv += v; qp += ge; } }
+                        else { se++; if (in) qe++; }
+                    }
+                if (qv != vis) {
+                    fprintf(stderr, "grid %d: query (%lld,%lld) visited %ld entries, the sorted lists say %ld\n",
+                            m, (long long)q.left, (long long)q.bot, vis, qv);
+                    return 1;
+                }
+                entries += vis; over += hits; empty += qe; passed += qp;
+                cells += (long long)(c1 - c0 + 1) * (r1 - r0 + 1);
+                s_entries += sv; s_empty += se;
+                if (hits > 0) {
+                    ratio_sum += (double)(vis + qe) / (double)hits;
+                    s_ratio_sum += (double)(sv + se) / (double)hits;
+                    nhit++;
+                }
             }
         double dt = now() - t0;
-        printf("grid %d entries %lld empty_cells %lld overlaps %lld queries %d mean_ratio %.6f seconds %.6f\n",
-               m, entries, empty, over, nq * nq, nhit ? ratio_sum / (double)nhit : 0.0, dt);
+        printf("grid %d entries %lld empty_cells %lld overlaps %lld queries %d mean_ratio %.6f "
+               "cells %lld passed %lld seed_entries %lld seed_empty %lld seed_mean_ratio %.6f seconds %.6f\n",
+               m, entries, empty, over, nq * nq, nhit ? ratio_sum / (double)nhit : 0.0,
+               cells, passed, s_entries, s_empty, nhit ? s_ratio_sum / (double)nhit : 0.0, dt);
         fflush(stdout);
-        free(occ);
+        free(start);
         hsr_gridlist_free(g);
 #undef COL
 #undef ROW
     }
-    free(e);
+    free(ck); free(keys); free(e);
     return 0;
 }
 

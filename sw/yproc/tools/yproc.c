@@ -18,6 +18,7 @@
 #include "yproc.h"
 
 int yproc_scan_main(int argc, char **argv);   /* yproc_scan.c */
+int yproc_serve_main(int argc, char **argv);  /* yproc_serve.c */
 int yproc_usage_error(const char *what, const char *arg);
 int yproc_apply_ops(hsr_ctx *h, const char *path, double **shade);   /* yproc_ops.c */
 
@@ -29,6 +30,7 @@ static const char USAGE[] =
     "                  [--capacity SLOTS] [--expect]\n"
     "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full]\n"
     "       yproc read SCENE -o FILE.json\n"
+    "       yproc serve SCENE --dir DIR\n"
     "\n"
     "hsr   exact hidden-surface removal of SCENE (docs/hsr.md)\n"
     "      --dump-llr F    the visible domains (LLR) as JSON     --dump-input F  the projected input faces\n"
@@ -45,6 +47,9 @@ static const char USAGE[] =
     "      --full          re-render every frame in full (the baseline)\n"
     "read  the scene and its OBJ/MTL files as read, as JSON (schema hsr-scene-1, docs/hsr.md):\n"
     "      what the Python reference renderer draws, so every format has one reader\n"
+    "serve the scene held for the viewer (docs/viewer.md): one request a line on stdin (pick,\n"
+    "      move, opacity, light, options, frame, info, quit), one JSON reply a line on stdout;\n"
+    "      a frame's changed lines are written to DIR/r.de48, g.de48, b.de48\n"
     "\n"
     "Errors are printed as \"file:line: message\" with exit status 1; a bad command line exits 2.\n";
 
@@ -76,11 +81,13 @@ int main(int argc, char **argv)
 {
     for (int i = 1; i < argc; i++)
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { fputs(USAGE, stdout); return 0; }
-    if (argc < 2) return yproc_usage_error("missing subcommand (hsr, scan, anim or read)", NULL);
-    if (strcmp(argv[1], "hsr") && strcmp(argv[1], "scan") && strcmp(argv[1], "anim") && strcmp(argv[1], "read"))
+    if (argc < 2) return yproc_usage_error("missing subcommand (hsr, scan, anim, read or serve)", NULL);
+    if (strcmp(argv[1], "hsr") && strcmp(argv[1], "scan") && strcmp(argv[1], "anim") && strcmp(argv[1], "read")
+        && strcmp(argv[1], "serve"))
         return yproc_usage_error("unknown subcommand", argv[1]);
     if (argc < 3) return yproc_usage_error("missing scene file after", argv[1]);
     if (!strcmp(argv[1], "read")) return read_main(argc, argv);
+    if (!strcmp(argv[1], "serve")) return yproc_serve_main(argc, argv);
     if (strcmp(argv[1], "hsr")) return yproc_scan_main(argc, argv);
     const char *scene = argv[2], *json = NULL, *svg = NULL, *input = NULL, *ops = NULL;
     int stats = 0, rebuild = 0;
