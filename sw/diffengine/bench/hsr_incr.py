@@ -237,7 +237,7 @@ def _anim_summary(frames: dict, sel) -> dict:
 
 
 def _pct(x: float) -> str:
-    return f"{100 * x:.1f} %" if x >= 0.01 else f"{100 * x:.2f} %"
+    return f"{100 * x:.1f} %" if x >= 0.01 else f"{100 * x:.2f} %" if x >= 1e-4 else f"{100 * x:.3f} %"
 
 
 def render(rec: dict) -> str:
