@@ -100,6 +100,9 @@ with the golden model, and writes every frame as an 8-bit PNG and the sequence a
 animated GIF. yproc itself re-renders every frame in full and compares the streams
 (its `frames_differing_from_full` must be 0, checked here); this script also checks that
 the image updated line by line equals a from-scratch golden render of the last frame.
+It also writes changed.json / changed.png: the instructions changed per scanline per
+frame (the slots of each new line not on the longest common subsequence of its commands
+with the previous frame's line, counted by yproc), as a histogram and per frame.
 
     diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim]
 
@@ -111,6 +114,67 @@ def render_lines(lines: list[bytes], width: int) -> np.ndarray:
     """Golden-model rows of the given lines (each a line's .de48 words, Refresh last)."""
     cmds, _ = binfmt.load_commands(to_de48(lines), "<delta>")
     return functional.render(cmds, width)
+
+
+def changed_histogram(st: dict, lines: list | None = None) -> dict:
+    """Changed instructions per scanline per frame from `anim_stats.json` (`changed_slots`:
+    per frame, colour and line, the instruction slots of the new line that are not on the
+    longest common subsequence of its commands with the previous frame's line; 0 for a
+    line that did not change). `lines`: the frames' streams (frames()), for the slots per
+    line. Returns per frame the median / 90th percentile / max over the 3 x H lines, the
+    count of lines that changed, and a histogram over every (frame >= 1, colour, line)."""
+    per = [f for f in st["frame"][1:] if "changed_slots" in f]
+    if not per:
+        return {}
+    cs = np.array([f["changed_slots"] for f in per])            # (F-1, 3, H)
+    flat = cs.reshape(len(per), -1)
+    edges = [0, 1, 3, 6, 11, 21, 41, 81, 161, 10 ** 9]
+    hist = np.histogram(flat.ravel(), bins=edges)[0]
+    out = {
+        "frames": [f["frame"] for f in per],
+        "median": np.median(flat, axis=1).tolist(),
+        "p90": np.percentile(flat, 90, axis=1).tolist(),
+        "max": flat.max(axis=1).tolist(),
+        "changed_lines": (flat > 0).sum(axis=1).tolist(),
+        "bins": [f"{a}-{b - 1}" if b - 1 > a else f"{a}" for a, b in zip(edges[:-2], edges[1:-1])] + [f">={edges[-2]}"],
+        "hist": hist.tolist(),
+        "median_all": float(np.median(flat)),
+        "median_changed_lines": float(np.median(flat[flat > 0])) if (flat > 0).any() else 0.0,
+    }
+    if lines is not None:
+        slots = [[len(ln) // 6 - 1 for ln in ch] for ch in lines[-1]]
+        out["mean_slots_per_line"] = float(np.mean(slots))
+    return out
+
+
+def plot_changed(h: dict, path, title: str) -> None:
+    """Histogram (all frames) and per-frame median / p90 / max of changed instructions."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
+    ax[0].bar(range(len(h["hist"])), h["hist"], color="#4477aa")
+    ax[0].set_xticks(range(len(h["hist"])), h["bins"], rotation=30)
+    ax[0].set_xlabel("changed instructions (slots) on a scanline, one colour")
+    ax[0].set_ylabel("scanlines x colours x frames")
+    ax[0].set_yscale("log")
+    ax[0].set_title("histogram over every frame")
+    fr = h["frames"]
+    ax[1].plot(fr, h["max"], label="max", color="#cc6677")
+    ax[1].plot(fr, h["p90"], label="90th percentile", color="#ddaa33")
+    ax[1].plot(fr, h["median"], label="median", color="#4477aa")
+    if "mean_slots_per_line" in h:
+        ax[1].axhline(h["mean_slots_per_line"], ls="--", color="grey",
+                      label=f"mean slots per line ({h['mean_slots_per_line']:.0f})")
+    ax[1].set_xlabel("frame")
+    ax[1].set_ylabel("changed instructions per scanline")
+    ax[1].set_ylim(bottom=0)
+    ax[1].legend(fontsize=8)
+    ax[1].set_title("per frame")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
 
 
 def configure(ap) -> None:
@@ -169,6 +233,15 @@ def command(a) -> int:
         gif = f", {out / 'anim.gif'}"
     except ImportError:
         gif = ""
+    h = changed_histogram(st, seq)
+    if h:
+        (out / "changed.json").write_text(json.dumps(h, indent=1) + "\n")
+        plot_changed(h, out / "changed.png", f"{Path(a.anim).name}: instructions changed between "
+                     "successive frames (LCS of each line's commands)")
+        print(f"  changed instructions per scanline (one colour, frames 1..{len(seq) - 1}): median "
+              f"{h['median_all']:.0f} over all lines, {h['median_changed_lines']:.0f} over the changed "
+              f"ones, max {max(h['max'])}; slots per line {h.get('mean_slots_per_line', 0):.0f} on average "
+              f"({out / 'changed.png'})")
     bad = st["frames_differing_from_full"]
     print(f"frames whose streams differ from yproc's full re-render: {bad}; last frame, "
           f"line-by-line update vs from-scratch render: {'identical' if pixel_ok else 'DIFFERENT'}")

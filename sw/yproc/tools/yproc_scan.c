@@ -25,6 +25,7 @@ typedef struct opts {
     const char *in, *out, *mode;
     yp_options yo;
     int frames, cmd, expect, full, width, height, mode_given;
+    int lod_loop;        /* anim: per-line level of detail from the Load Monitor model */
 } opts;
 
 static int parse(int argc, char **argv, opts *o)
@@ -40,6 +41,8 @@ static int parse(int argc, char **argv, opts *o)
         else if (!strcmp(a, "--cmd")) o->cmd = 1;
         else if (!strcmp(a, "--expect")) o->expect = 1;
         else if (!strcmp(a, "--full")) o->full = 1;
+        else if (!strcmp(a, "--no-degrade")) o->yo.no_degrade = 1;
+        else if (!strcmp(a, "--lod-loop")) { o->lod_loop = 1; o->yo.no_degrade = 1; }
         else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
                  && strcmp(a, "--tol") && strcmp(a, "--capacity"))
             return yproc_usage_error("unknown option", a);
@@ -284,6 +287,36 @@ static int copy_lines(yp_cmdlist *dst, const yp_frame *fr)
     return 0;
 }
 
+/* the frame as the Load Monitor records it (yp_lod_monitor_line, per line: the
+ * largest count of the three colours, late if any is): overflowing lines, the mean
+ * level of detail and, with the loop, the levels of the next frame after the update */
+static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap)
+{
+    int H = fr->height, ovl = 0, *iss = malloc(sizeof(int) * (size_t)H), *late = malloc(sizeof(int) * (size_t)H);
+    if (!iss || !late) { free(iss); free(late); return 1; }
+    for (int y = 0; y < H; y++) {
+        iss[y] = late[y] = 0;
+        for (int c = 0; c < 3; c++) {
+            int i, l;
+            yp_lod_monitor_line(fr->st[y].slots[c], cap, &i, &l);
+            if (i > iss[y]) iss[y] = i;
+            late[y] |= l;
+        }
+        ovl += late[y];
+    }
+    const unsigned char *lv = yp_lod_levels(lod);
+    double mean = YP_LOD_MAX;
+    if (lv) { mean = 0; for (int y = 0; y < H; y++) mean += lv[y]; mean /= H; }
+    fprintf(js, ", \"overflow_lines\": %d, \"mean_level\": %.4f, \"levels\": [", ovl, mean);
+    for (int y = 0; y < H; y++) fprintf(js, "%s%d", y ? ", " : "", lv ? lv[y] : YP_LOD_MAX);
+    fprintf(js, "], \"issued\": [");
+    for (int y = 0; y < H; y++) fprintf(js, "%s%d", y ? ", " : "", iss[y]);
+    fprintf(js, "]");
+    if (lod) yp_lod_update(lod, iss, late);
+    free(iss); free(late);
+    return 0;
+}
+
 static int anim_main(opts *o)
 {
     char err[1024] = "", p[4096];
@@ -298,13 +331,20 @@ static int anim_main(opts *o)
     double *shade;
     int rc = 0, F = yp_anim_frames(an), W = sc->width, H = sc->height;
     yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
+    int *chslots = calloc(3 * (size_t)H, sizeof(int));
+    unsigned char *lod_prev = malloc((size_t)H + 1);
     char *changed[3];
     for (int c = 0; c < 3; c++) changed[c] = calloc((size_t)H, 1);
-    if (!prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
+    if (!prev || !chslots || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
+    memset(lod_prev, YP_LOD_MAX, (size_t)H);
+    yp_lod *lod = NULL;
     if ((st = yp_anim_apply(an, 0, NULL, NULL, NULL, NULL)) != HSR_OK
-        || (st = yp_shader_new(sc, o->yo.shading, &sh, err, sizeof err)) != HSR_OK) {
+        || (st = yp_shader_new(sc, o->yo.shading, &sh, err, sizeof err)) != HSR_OK
+        || (st = yp_anim_apply(an, 0, NULL, sh, NULL, NULL)) != HSR_OK     /* point lights, textures */
+        || (o->lod_loop && (st = yp_lod_new(H, o->yo.capacity, &lod)) != HSR_OK)) {
         fprintf(stderr, "%s\n", err[0] ? err : hsr_status_str(st)); rc = 1; goto out;
     }
+    if (lod) o->yo.line_lod = yp_lod_levels(lod);
     double t0 = now_ms();
     if ((st = hsr_scene_build(sc, &h, &shade)) != HSR_OK) { fprintf(stderr, "%s: %s\n", o->in, hsr_status_str(st)); rc = 1; goto out; }
     free(shade);
@@ -317,7 +357,10 @@ static int anim_main(opts *o)
     FILE *js = fopen(p, "w");
     if (!js) { rc = 1; goto out; }
     fprintf(js, "{\"format\": \"yproc-anim-1\", \"anim\": \"%s\", \"frames\": %d, \"width\": %d, \"height\": %d, "
-                "\"capacity\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f}", o->in, F, W, H, o->yo.capacity, t1 - t0);
+                "\"capacity\": %d, \"lod_loop\": %d, \"no_degrade\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f",
+            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->yo.no_degrade, t1 - t0);
+    if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; fclose(js); goto out; }
+    fprintf(js, "}");
     double sum_inc = 0, sum_full = 0, sum_inc_scan = 0, sum_full_scan = 0;
     long sum_changed = 0;
     int mismatches = 0, degraded_lines = 0;
@@ -325,6 +368,10 @@ static int anim_main(opts *o)
         int y0, y1;
         double a0 = now_ms();
         st = yp_anim_apply(an, f, h, sh, &y0, &y1);
+        /* lines whose level of detail changed are re-scanned too */
+        for (int y = 0; lod && y < H; y++)
+            if (lod_prev[y] != yp_lod_levels(lod)[y]) { if (y0 == y1) { y0 = y; y1 = y + 1; } if (y < y0) y0 = y; if (y + 1 > y1) y1 = y + 1; }
+        if (lod) memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
         double am = now_ms();
         if (st == HSR_OK) st = yp_scan(sh, h, &o->yo, y0, y1, fr);
         double a1 = now_ms();
@@ -334,6 +381,8 @@ static int anim_main(opts *o)
             for (int y = 0; y < H; y++) {
                 changed[c][y] = y >= y0 && y < y1 && !yp_cmdlist_equal(&fr->line[c * H + y], &prev[c * H + y]);
                 nch[c] += changed[c][y];
+                /* instructions of the line that the delta really changes (LCS of the commands) */
+                chslots[c * H + y] = changed[c][y] ? yp_cmdlist_changed_slots(&prev[c * H + y], &fr->line[c * H + y]) : 0;
             }
         snprintf(p, sizeof p, "%s/frame%03d.delta", o->out, f);
         if (write_delta(p, f, fr, changed) || copy_lines(prev, fr)) { rc = 1; break; }
@@ -363,8 +412,14 @@ static int anim_main(opts *o)
         fprintf(js, ",\n  {\"frame\": %d, \"rescanned_lines\": [%d, %d], \"changed_lines\": [%d, %d, %d], "
                     "\"incremental_ms\": %.3f, \"incremental_hsr_ms\": %.3f, \"incremental_scan_ms\": %.3f, "
                     "\"delta_write_ms\": %.3f, \"full_ms\": %.3f, \"full_hsr_ms\": %.3f, \"full_scan_ms\": %.3f, "
-                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d}",
+                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d",
                 f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am, a2 - a1, b1 - b0, bm - b0, b1 - bm, diff, deg);
+        fprintf(js, ", \"changed_slots\": [");
+        for (int c = 0; c < 3; c++)
+            for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chslots[c * H + y], y == H - 1 ? "]" : "");
+        fprintf(js, "]");
+        if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; break; }
+        fprintf(js, "}");
         printf("frame %3d: lines %3d..%3d rescanned, changed r/g/b %d/%d/%d; incremental %.1f ms (hsr %.1f + scan %.1f), "
                "full %.1f ms (hsr %.1f + scan %.1f)%s\n", f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am,
                b1 - b0, bm - b0, b1 - bm, diff ? " MISMATCH with full re-render" : "");
@@ -383,7 +438,7 @@ static int anim_main(opts *o)
     }
 out:
     if (prev) for (int i = 0; i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
-    free(prev);
+    free(prev); free(chslots); free(lod_prev); yp_lod_free(lod);
     for (int c = 0; c < 3; c++) free(changed[c]);
     yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); yp_anim_free(an);
     return rc;

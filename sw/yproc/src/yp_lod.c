@@ -1,0 +1,133 @@
+/* yp_lod.c - the Load Monitor loop (section 7.5: "based on this information,
+ * higher level processes may adapt the level of detail or the quality of the
+ * illumination model"; docs/yproc.md section 10): per line a level of detail,
+ * lowered where the previous frame's line was late or close to the capacity and
+ * raised again where the load predicted at the higher level fits. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "yp_internal.h"
+
+/* per level: colour-function order cap (3 Eval3, 2 Eval2, 1 Eval1), anti-aliasing,
+ * tolerance factor, texture term.  Ordered by cost on the shipped scenes (docs/yproc.md
+ * section 10): anti-aliasing is the largest single cost (about 3.5 slots per pattern
+ * row), then the order and the tolerance of the colour functions. */
+static const struct { int order, aa; double tolf; int tex; } LEV[YP_LOD_MAX + 1] = {
+    {1, 0, 16, 0},   /* 0: Eval1 pieces, point sampled, no texture */
+    {2, 0, 16, 0},   /* 1: Eval2, point sampled, no texture */
+    {2, 0, 4, 1},    /* 2: Eval2, point sampled */
+    {3, 0, 4, 1},    /* 3: Eval3, point sampled */
+    {3, 1, 4, 1},    /* 4: Eval3, area sampled, tolerance x4 */
+    {3, 1, 1, 1},    /* 5: the base options */
+};
+
+void yp_lod_line_options(const yp_options *base, int lev, int *maxlev, int *aa, double *tol, int *texture)
+{
+    if (lev < 0) lev = 0;
+    if (lev > YP_LOD_MAX) lev = YP_LOD_MAX;
+    int top = base->shading == YP_FLAT ? 1 : base->shading == YP_GOURAUD ? 2 : 3;
+    *maxlev = LEV[lev].order < top ? LEV[lev].order : top;
+    *aa = LEV[lev].aa && base->aa;
+    *tol = base->tol * LEV[lev].tolf;
+    *texture = LEV[lev].tex;
+}
+
+void yp_lod_monitor_line(int slots, int capacity, int *issued, int *late)
+{
+    /* the window has capacity + 1 slots (HTotal - 1); a line whose marker cannot reach
+     * the buffer's head inside it is late and the window is filled with its words */
+    *late = slots > capacity;
+    *issued = *late ? capacity + 1 : slots;
+}
+
+#define HIGH 0.80       /* high-water mark: lower a line above it */
+#define RAISE 0.70      /* raise only if the predicted load stays below this */
+#define BACKOFF0 4      /* frames before a level that was late is tried again (doubling) */
+
+struct yp_lod {
+    int H, cap;
+    unsigned char *lev;
+    int *prev_issued;         /* last frame's issued, -1 unknown */
+    unsigned char *prev_lev;
+    int *block;               /* per line and level: frame before which it is not tried again */
+    int *backoff;             /* per line and level: the last wait, doubled at each late try */
+    int frame;
+    double ratio[YP_LOD_MAX]; /* learned load(k + 1) / load(k) */
+};
+
+hsr_status yp_lod_new(int height, int capacity, yp_lod **out)
+{
+    if (!out || height < 1 || capacity < 1) return HSR_EINVAL;
+    yp_lod *l = calloc(1, sizeof *l);
+    if (!l) return HSR_ENOMEM;
+    l->H = height; l->cap = capacity;
+    l->lev = malloc((size_t)height);
+    l->prev_lev = malloc((size_t)height);
+    l->prev_issued = malloc(sizeof(int) * (size_t)height);
+    l->block = calloc((size_t)height * (YP_LOD_MAX + 1), sizeof(int));
+    l->backoff = calloc((size_t)height * (YP_LOD_MAX + 1), sizeof(int));
+    if (!l->lev || !l->prev_lev || !l->prev_issued || !l->block || !l->backoff) { yp_lod_free(l); return HSR_ENOMEM; }
+    memset(l->lev, YP_LOD_MAX, (size_t)height);
+    memset(l->prev_lev, YP_LOD_MAX, (size_t)height);
+    for (int y = 0; y < height; y++) l->prev_issued[y] = -1;
+    for (int k = 0; k < YP_LOD_MAX; k++) l->ratio[k] = 1.6;
+    *out = l;
+    return HSR_OK;
+}
+
+void yp_lod_free(yp_lod *l)
+{
+    if (!l) return;
+    free(l->lev); free(l->prev_lev); free(l->prev_issued); free(l->block); free(l->backoff); free(l);
+}
+
+const unsigned char *yp_lod_levels(const yp_lod *l) { return l ? l->lev : NULL; }
+
+int yp_lod_update(yp_lod *l, const int *issued, const int *late)
+{
+    if (!l || !issued || !late) return 0;
+    const int H = l->H;
+    const double cap = l->cap;
+    /* learn the cost ratio between adjacent levels from lines that moved by one level
+     * between two frames without being late in either (load here / load there) */
+    double sum[YP_LOD_MAX] = {0};
+    int cnt[YP_LOD_MAX] = {0};
+    for (int y = 0; y < H; y++) {
+        int a = l->prev_lev[y], b = l->lev[y];
+        if (l->prev_issued[y] <= 0 || issued[y] <= 0 || late[y] || abs(a - b) != 1 || l->prev_issued[y] > cap) continue;
+        int k = a < b ? a : b;
+        double lo = a < b ? l->prev_issued[y] : issued[y], hi = a < b ? issued[y] : l->prev_issued[y];
+        sum[k] += hi / lo; cnt[k]++;
+    }
+    for (int k = 0; k < YP_LOD_MAX; k++)
+        if (cnt[k]) l->ratio[k] = fmax(1.0, 0.5 * l->ratio[k] + 0.5 * sum[k] / cnt[k]);
+    int changed = 0;
+    for (int y = 0; y < H; y++) {
+        int lv = l->lev[y], nl = lv;
+        /* the line and its neighbours: what moves vertically brings its load along */
+        int load = issued[y];
+        if (y > 0 && issued[y - 1] > load) load = issued[y - 1];
+        if (y + 1 < H && issued[y + 1] > load) load = issued[y + 1];
+        int *bo = &l->backoff[y * (YP_LOD_MAX + 1)], *bl = &l->block[y * (YP_LOD_MAX + 1)];
+        if (late[y]) {
+            /* the excess is unknown (a late line's count is its window): two levels down,
+             * and this level is not tried again for a while (doubling at each late try) */
+            nl = lv >= 2 ? lv - 2 : 0;
+            bo[lv] = bo[lv] ? 2 * bo[lv] : BACKOFF0;
+            if (bo[lv] > 256) bo[lv] = 256;
+            bl[lv] = l->frame + bo[lv];
+        } else if (issued[y] > HIGH * cap) {
+            nl = lv > 0 ? lv - 1 : 0;
+        } else if (lv < YP_LOD_MAX && load * l->ratio[lv] < RAISE * cap && l->frame >= bl[lv + 1]) {
+            nl = lv + 1;
+        } else if (l->frame >= bl[lv] + 4 * bo[lv]) {
+            bo[lv] = 0;   /* on time at this level long enough: forget its late tries */
+        }
+        l->prev_lev[y] = (unsigned char)lv;
+        l->prev_issued[y] = issued[y];
+        l->lev[y] = (unsigned char)nl;
+        changed += nl != lv;
+    }
+    l->frame++;
+    return changed;
+}
