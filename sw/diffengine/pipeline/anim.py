@@ -116,6 +116,25 @@ def render_lines(lines: list[bytes], width: int) -> np.ndarray:
     return functional.render(cmds, width)
 
 
+def golden_frame(streams: list[list[bytes]], width: int) -> np.ndarray:
+    """One frame (three colours' lines) through the golden model: (H, W, 3)."""
+    return np.stack([render_lines(streams[c], width) for c in range(3)], axis=-1)
+
+
+def play_rtl(seq: list[list[list[bytes]]], width: int, height: int, chips: int,
+             workdir: Path, test: tuple | None = None) -> tuple[np.ndarray, dict]:
+    """Every frame of `seq` (frames()) one after the other through the Verilated display
+    controller in test mode (diffengine.rtl.dc_harness); `test`: the geometry (default
+    demo.controller_setup's, HTotal 800). Returns (frames (F, H, W, 3), harness stats)."""
+    from ..rtl import dc_harness
+    from .demo import controller_setup
+    cfg = dc_harness.Config(chips=chips, test=test or controller_setup(width, height, chips)[1])
+    paths = [Path(workdir) / f"rtl_{c}.de48" for c in "rgb"]
+    for c in range(3):
+        paths[c].write_bytes(to_de48([ln for fr in seq for ln in fr[c]]))
+    return dc_harness.run(paths, cfg, mode=3)
+
+
 def changed_histogram(st: dict, lines: list | None = None) -> dict:
     """Changed instructions per scanline per frame from `anim_stats.json` (`changed_slots`:
     per frame, colour and line, the instruction slots of the new line that are not on the

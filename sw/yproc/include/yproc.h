@@ -121,9 +121,14 @@ int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b);
  * 5 base, 4 tolerance x4, 3 Gouraud-order colour functions, 2 flat (Eval1),
  * 1 flat without anti-aliasing, 0 flat, no anti-aliasing, no texture term */
 void yp_lod_line_options(const yp_options *base, int lev, int *maxlev, int *aa, double *tol, int *texture);
-/* What the Load Monitor (rtl/ctrl/de_load_monitor.sv) records for a line of `slots`
- * instructions in a window of `capacity` slots: issued = min(slots, capacity), late. */
-void yp_lod_monitor_line(int slots, int capacity, int *issued, int *late);
+/* What the Load Monitor (rtl/ctrl/de_load_monitor.sv) records for the n lines of one
+ * colour's frame, line l holding slots[l] instructions (its marker aside), in windows
+ * of capacity + 1 slots (HTotal - 1): a line is on time if its instructions and its
+ * marker fit in what the window has left after discarding the tail of a late line
+ * before it (docs/display-controller.md section 2.4: one word per slot); issued[l] is
+ * then slots[l], else the rest of the window, and late[l] = 1 (checked against the
+ * Verilated controller, sw/tests/test_fig727_lod.py). */
+void yp_lod_monitor(const int *slots, int n, int capacity, int *issued, int *late);
 typedef struct yp_lod yp_lod;
 hsr_status yp_lod_new(int height, int capacity, yp_lod **out);
 void yp_lod_free(yp_lod *l);

@@ -32,12 +32,18 @@ void yp_lod_line_options(const yp_options *base, int lev, int *maxlev, int *aa, 
     *texture = LEV[lev].tex;
 }
 
-void yp_lod_monitor_line(int slots, int capacity, int *issued, int *late)
+void yp_lod_monitor(const int *slots, int n, int capacity, int *issued, int *late)
 {
-    /* the window has capacity + 1 slots (HTotal - 1); a line whose marker cannot reach
-     * the buffer's head inside it is late and the window is filled with its words */
-    *late = slots > capacity;
-    *issued = *late ? capacity + 1 : slots;
+    long drain = 0;   /* words of a late line still to be discarded (its marker included) */
+    for (int l = 0; l < n; l++) {
+        long room = capacity + 1 - drain;          /* slots of this window after the discard */
+        drain = room < 0 ? -room : 0;
+        if (room < 0) room = 0;
+        int sl = slots[l];                          /* slots and issued may be one array */
+        late[l] = sl + 1 > room;
+        issued[l] = late[l] ? (int)room : sl;
+        if (late[l]) drain += sl + 1 - room;
+    }
 }
 
 #define HIGH 0.80       /* high-water mark: lower a line above it */

@@ -281,12 +281,19 @@ static void test_lod_update_lowers_late_lines_and_raises_when_load_falls(void)
     int iss3[4] = {20, 20, 20, 10};
     for (int k = 0; k < 8; k++) yp_lod_update(l, iss3, late2);
     CHECK(lv[0] == YP_LOD_MAX && lv[1] == YP_LOD_MAX);
-    /* the monitor model: a late line fills its window */
-    int i, lt;
-    yp_lod_monitor_line(120, 100, &i, &lt);
-    CHECK(i == 101 && lt == 1);
-    yp_lod_monitor_line(100, 100, &i, &lt);
-    CHECK(i == 100 && lt == 0);
+    /* the monitor model: a late line fills its window (capacity + 1 slots) and its tail
+     * is discarded in the next window, which can make that line late too */
+    int sl[5] = {120, 90, 40, 100, 3}, is[5], lt[5];
+    yp_lod_monitor(sl, 5, 100, is, lt);
+    /* 120 + marker: 101 issued, 20 left; 90 + 1 > 101 - 20: late, 81 issued, 10 left;
+     * 40 fits in 91; 100 fits exactly; 3 */
+    CHECK(is[0] == 101 && lt[0] == 1 && is[1] == 81 && lt[1] == 1);
+    CHECK(is[2] == 40 && lt[2] == 0 && is[3] == 100 && lt[3] == 0 && is[4] == 3 && lt[4] == 0);
+    yp_lod_monitor(sl, 5, 100, sl, lt);  /* in place, as yproc anim calls it */
+    CHECK(!memcmp(sl, is, sizeof is));
+    int sl2[3] = {350, 10, 10};         /* a tail longer than a window */
+    yp_lod_monitor(sl2, 3, 100, is, lt);
+    CHECK(is[0] == 101 && is[1] == 0 && lt[1] == 1 && is[2] == 0 && lt[2] == 1);
     yp_lod_free(l);
     /* the level's options: the top is the base, lower levels cheaper */
     yp_options o;
@@ -345,18 +352,18 @@ static void test_lod_loop_removes_overflow_and_restores_quality(void)
         if (f) CHECK(yp_anim_apply(t.an, f, h, sh, &y0, &y1) == HSR_OK);
         CHECK(yp_scan(sh, h, &o, 0, H, fr) == HSR_OK);   /* every line: the levels may change anywhere */
         ovl[f] = 0; mean[f] = 0;
-        for (int y = 0; y < H; y++) {
-            iss[y] = late[y] = 0;
-            for (int c = 0; c < 3; c++) {
-                int i, l;
-                yp_lod_monitor_line(fr->st[y].slots[c], o.capacity, &i, &l);
-                if (i > iss[y]) iss[y] = i;
-                late[y] |= l;
-                CHECK(fr->st[y].overflow[c] == l);
+        for (int y = 0; y < H; y++) iss[y] = late[y] = 0;
+        for (int c = 0; c < 3; c++) {
+            int sl[64], ic[64], lc[64];
+            for (int y = 0; y < H; y++) sl[y] = fr->st[y].slots[c];
+            yp_lod_monitor(sl, H, o.capacity, ic, lc);
+            for (int y = 0; y < H; y++) {
+                if (ic[y] > iss[y]) iss[y] = ic[y];
+                late[y] |= lc[y];
+                CHECK(!fr->st[y].overflow[c] || lc[y]);   /* a line over the capacity is late */
             }
-            ovl[f] += late[y];
-            mean[f] += o.line_lod[y];
         }
+        for (int y = 0; y < H; y++) { ovl[f] += late[y]; mean[f] += o.line_lod[y]; }
         mean[f] /= H;
         if (getenv("T_VERBOSE")) {
             fprintf(stderr, "frame %d: overflow %d, mean level %.2f, capacity %d:", f, ovl[f], mean[f], o.capacity);

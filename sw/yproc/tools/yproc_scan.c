@@ -287,23 +287,20 @@ static int copy_lines(yp_cmdlist *dst, const yp_frame *fr)
     return 0;
 }
 
-/* the frame as the Load Monitor records it (yp_lod_monitor_line, per line: the
+/* the frame as the Load Monitor records it (yp_lod_monitor, per line: the
  * largest count of the three colours, late if any is): overflowing lines, the mean
  * level of detail and, with the loop, the levels of the next frame after the update */
 static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap)
 {
-    int H = fr->height, ovl = 0, *iss = malloc(sizeof(int) * (size_t)H), *late = malloc(sizeof(int) * (size_t)H);
-    if (!iss || !late) { free(iss); free(late); return 1; }
-    for (int y = 0; y < H; y++) {
-        iss[y] = late[y] = 0;
-        for (int c = 0; c < 3; c++) {
-            int i, l;
-            yp_lod_monitor_line(fr->st[y].slots[c], cap, &i, &l);
-            if (i > iss[y]) iss[y] = i;
-            late[y] |= l;
-        }
-        ovl += late[y];
+    int H = fr->height, ovl = 0, *iss = calloc(4 * (size_t)H + 1, sizeof(int));
+    if (!iss) return 1;
+    int *late = iss + H, *ic = iss + 2 * H, *lc = iss + 3 * H;
+    for (int c = 0; c < 3; c++) {
+        for (int y = 0; y < H; y++) ic[y] = fr->st[y].slots[c];
+        yp_lod_monitor(ic, H, cap, ic, lc);
+        for (int y = 0; y < H; y++) { if (ic[y] > iss[y]) iss[y] = ic[y]; late[y] |= lc[y]; }
     }
+    for (int y = 0; y < H; y++) ovl += late[y];
     const unsigned char *lv = yp_lod_levels(lod);
     double mean = YP_LOD_MAX;
     if (lv) { mean = 0; for (int y = 0; y < H; y++) mean += lv[y]; mean /= H; }
@@ -313,7 +310,7 @@ static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap)
     for (int y = 0; y < H; y++) fprintf(js, "%s%d", y ? ", " : "", iss[y]);
     fprintf(js, "]");
     if (lod) yp_lod_update(lod, iss, late);
-    free(iss); free(late);
+    free(iss);
     return 0;
 }
 
