@@ -196,17 +196,95 @@ def plot_changed(h: dict, path, title: str) -> None:
     plt.close(fig)
 
 
+# ---- the Load Monitor loop, before and after (docs/yproc.md section 10) -----------------
+
+LOD_RUNS = (("open", ("--no-degrade",), "open loop: full quality, no look-ahead"),
+            ("ahead", (), "look-ahead degradation inside each line (yproc's default)"),
+            ("loop", ("--lod-loop",), "Load Monitor loop: per-line level from the previous frame"))
+
+
+def lod_compare(anim_path, out: Path, extra=()) -> dict:
+    """`yproc anim` three times (LOD_RUNS): per frame the lines the Load Monitor (yproc's
+    model of it, equal to the RTL's: test_fig727_lod.py) reports late, the mean level of
+    detail, and for the loop the level of every line. Writes lod.json and lod.png."""
+    yproc = build_yproc()
+    res = {}
+    for name, flags, _ in LOD_RUNS:
+        d = out / f"lod_{name}"
+        t0 = time.time()
+        r = subprocess.run([str(yproc), "anim", str(anim_path), "-o", str(d), *flags, *extra],
+                           capture_output=True, text=True)
+        if r.returncode:
+            raise RuntimeError(f"yproc anim {' '.join(flags)} failed:\n{r.stderr}")
+        st = json.loads((d / "anim_stats.json").read_text())
+        fr = st["frame"]
+        res[name] = {"overflow_lines": [f["overflow_lines"] for f in fr],
+                     "mean_level": [f["mean_level"] for f in fr],
+                     "max_issued": [max(f["issued"]) for f in fr],
+                     "levels": [f["levels"] for f in fr],
+                     "capacity": st["capacity"], "mean_scan_ms": st["mean_incremental_scan_ms"]}
+        print(f"  {name}: overflowing lines per frame {res[name]['overflow_lines']} "
+              f"({time.time() - t0:.0f} s)", flush=True)
+    (out / "lod.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if kk != "levels"}
+                                              for k, v in res.items()}, indent=1) + "\n")
+    plot_lod(res, out / "lod.png", Path(anim_path).name)
+    return res
+
+
+def plot_lod(res: dict, path, title: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
+    col = {"open": "#cc6677", "ahead": "#ddaa33", "loop": "#4477aa"}
+    for name, _, label in LOD_RUNS:
+        r = res[name]
+        ax[0].plot(r["overflow_lines"], label=label, color=col[name], marker=".")
+        ax[1].plot(r["mean_level"], label=label, color=col[name], marker=".")
+    ax[0].set_xlabel("frame")
+    ax[0].set_ylabel("late (overflowing) lines")
+    ax[0].set_title("overflowing lines per frame")
+    ax[0].legend(fontsize=7)
+    ax[1].set_xlabel("frame")
+    ax[1].set_ylabel("mean level of detail (5 = full)")
+    ax[1].set_title("quality per frame")
+    ax[1].set_ylim(0, 5.3)
+    lv = np.array(res["loop"]["levels"]).T
+    im = ax[2].imshow(lv, aspect="auto", cmap="viridis", vmin=0, vmax=5, interpolation="nearest")
+    ax[2].set_xlabel("frame")
+    ax[2].set_ylabel("scanline")
+    ax[2].set_title("the loop's level per line")
+    fig.colorbar(im, ax=ax[2], fraction=0.05)
+    fig.suptitle(f"{title}: capacity {res['loop']['capacity']} slots per line and colour", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def configure(ap) -> None:
     """The arguments of `diffengine anim` (make anim)."""
     ap.epilog = COMMAND_HELP
     ap.add_argument("--anim", default=str(REPO / "sw/scenes/anim/cad_drag.anim"))
     ap.add_argument("--out", default=str(REPO / "out" / "anim"))
+    ap.add_argument("--lod-compare", action="store_true",
+                    help="instead: the animation three times (open loop, look-ahead degradation, "
+                         "Load Monitor loop): overflowing lines and quality per frame -> OUT/lod.png, "
+                         "lod.json (docs/yproc.md section 10)")
     ap.set_defaults(func=command)
 
 
 def command(a) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.lod_compare:
+        print(f"anim: {a.anim} three times (open loop, look-ahead, Load Monitor loop)", flush=True)
+        try:
+            lod_compare(a.anim, out)
+        except RuntimeError as e:
+            print(f"anim: error: {e}", file=sys.stderr)
+            return 1
+        print(f"wrote {out / 'lod.png'}, {out / 'lod.json'}")
+        return 0
     yproc = build_yproc()
     t0 = time.time()
     print(f"anim: yproc anim {a.anim} (each frame also re-rendered in full for the check)", flush=True)

@@ -118,8 +118,10 @@ int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b);
 /* ---- level of detail from the Load Monitor (yp_lod.c, docs/yproc.md section 10) ---- */
 #define YP_LOD_MAX 5
 /* the options of line level lev (0..YP_LOD_MAX; YP_LOD_MAX = the base options):
- * 5 base, 4 tolerance x4, 3 Gouraud-order colour functions, 2 flat (Eval1),
- * 1 flat without anti-aliasing, 0 flat, no anti-aliasing, no texture term */
+ * 5 base; 4 tolerance x4; 3 also point sampled (no anti-aliasing); 2 also Eval2
+ * colour functions; 1 tolerance x16 and no texture term; 0 tolerance x64.  Each step
+ * costs fewer slots on the shipped scenes (docs/yproc.md section 10; Eval1 pieces of a
+ * Phong-shaded face cost more than Eval2, so "flat" is not a level) */
 void yp_lod_line_options(const yp_options *base, int lev, int *maxlev, int *aa, double *tol, int *texture);
 /* What the Load Monitor (rtl/ctrl/de_load_monitor.sv) records for the n lines of one
  * colour's frame, line l holding slots[l] instructions (its marker aside), in windows

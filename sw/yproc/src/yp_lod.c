@@ -13,7 +13,7 @@
  * section 10): anti-aliasing is the largest single cost (about 3.5 slots per pattern
  * row), then the order and the tolerance of the colour functions. */
 static const struct { int order, aa; double tolf; int tex; } LEV[YP_LOD_MAX + 1] = {
-    {1, 0, 16, 0},   /* 0: Eval1 pieces, point sampled, no texture */
+    {2, 0, 64, 0},   /* 0: Eval2, point sampled, tolerance x64, no texture */
     {2, 0, 16, 0},   /* 1: Eval2, point sampled, no texture */
     {2, 0, 4, 1},    /* 2: Eval2, point sampled */
     {3, 0, 4, 1},    /* 3: Eval3, point sampled */

@@ -303,7 +303,7 @@ static void test_lod_update_lowers_late_lines_and_raises_when_load_falls(void)
     yp_lod_line_options(&o, YP_LOD_MAX, &ml, &aa, &tol, &tx);
     CHECK(ml == 3 && aa == 1 && tol == o.tol && tx == 1);
     yp_lod_line_options(&o, 0, &ml, &aa, &tol, &tx);
-    CHECK(ml == 1 && aa == 0 && tol > o.tol && tx == 0);
+    CHECK(ml == 2 && aa == 0 && tol == 64 * o.tol && tx == 0);
 }
 
 /* The loop on a scene that overloads: a dense grid of small Phong quads (many patterns

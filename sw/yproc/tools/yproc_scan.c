@@ -26,13 +26,14 @@ typedef struct opts {
     yp_options yo;
     int frames, cmd, expect, full, width, height, mode_given;
     int lod_loop;        /* anim: per-line level of detail from the Load Monitor model */
+    int lod_all;         /* scan: every line at this level of detail (-1: the options) */
 } opts;
 
 static int parse(int argc, char **argv, opts *o)
 {
     memset(o, 0, sizeof *o);
     yp_options_default(&o->yo);
-    o->in = argv[2]; o->mode = "640x480"; o->frames = 1;
+    o->in = argv[2]; o->mode = "640x480"; o->frames = 1; o->lod_all = -1;
     int cap = 0;
     for (int i = 3; i < argc; i++) {
         const char *a = argv[i];
@@ -44,7 +45,7 @@ static int parse(int argc, char **argv, opts *o)
         else if (!strcmp(a, "--no-degrade")) o->yo.no_degrade = 1;
         else if (!strcmp(a, "--lod-loop")) { o->lod_loop = 1; o->yo.no_degrade = 1; }
         else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
-                 && strcmp(a, "--tol") && strcmp(a, "--capacity"))
+                 && strcmp(a, "--tol") && strcmp(a, "--capacity") && strcmp(a, "--lod"))
             return yproc_usage_error("unknown option", a);
         else if (!has_value) return yproc_usage_error("missing value after", a);
         else if (!strcmp(a, "-o")) o->out = argv[++i];
@@ -58,6 +59,11 @@ static int parse(int argc, char **argv, opts *o)
         } else if (!strcmp(a, "--frames")) {
             o->frames = atoi(argv[++i]);
             if (o->frames < 1) return yproc_usage_error("--frames takes a count >= 1, not", argv[i]);
+        } else if (!strcmp(a, "--lod")) {
+            char *end;
+            long v = strtol(argv[++i], &end, 10);
+            if (*end || v < 0 || v > YP_LOD_MAX) return yproc_usage_error("--lod takes a level 0..5, not", argv[i]);
+            o->lod_all = (int)v;
         } else if (!strcmp(a, "--tol")) {
             o->yo.tol = atof(argv[++i]);
             if (!(o->yo.tol >= 0.01)) return yproc_usage_error("--tol takes a number >= 0.01, not", argv[i]);
@@ -208,7 +214,12 @@ static int scan_main(opts *o)
     free(shade);
     double t2 = now_ms();
     yp_frame *fr = NULL;
+    unsigned char *lv = NULL;
     st = yp_frame_new(sc->width, sc->height, &fr);
+    if (o->lod_all >= 0 && st == HSR_OK) {
+        if (!(lv = malloc((size_t)sc->height))) st = HSR_ENOMEM;
+        else { memset(lv, o->lod_all, (size_t)sc->height); o->yo.line_lod = lv; }
+    }
     for (int k = 0; k < o->frames && st == HSR_OK; k++) st = yp_scan(sh, h, &o->yo, 0, sc->height, fr);
     double t3 = now_ms();
     int rc = 0;
@@ -232,7 +243,7 @@ static int scan_main(opts *o)
             fprintf(stderr, "yproc: warning: %d line(s) exceed %d slots even as one spline per line (see stats.json)\n",
                     t.lines_overflow, o->yo.capacity);
     }
-    yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); hsr_scene_free(sc);
+    yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); hsr_scene_free(sc); free(lv);
     return rc;
 }
 
