@@ -270,6 +270,8 @@ def configure(ap) -> None:
                     help="instead: the animation three times (open loop, look-ahead degradation, "
                          "Load Monitor loop): overflowing lines and quality per frame -> OUT/lod.png, "
                          "lod.json (docs/yproc.md section 10)")
+    ap.add_argument("--mode", choices=("640x480", "640x485", "1280x1024"),
+                    help="with --lod-compare: the video mode (raster and slots per line) for yproc")
     ap.set_defaults(func=command)
 
 
@@ -279,7 +281,7 @@ def command(a) -> int:
     if a.lod_compare:
         print(f"anim: {a.anim} three times (open loop, look-ahead, Load Monitor loop)", flush=True)
         try:
-            lod_compare(a.anim, out)
+            lod_compare(a.anim, out, ("--mode", a.mode) if a.mode else ())
         except RuntimeError as e:
             print(f"anim: error: {e}", file=sys.stderr)
             return 1

@@ -57,6 +57,10 @@ struct yp_lod {
     unsigned char *prev_lev;
     int *block;               /* per line and level: frame before which it is not tried again */
     int *backoff;             /* per line and level: the last wait, doubled at each late try */
+    double *rl;               /* per line and level k: load(k + 1) / load(k) measured on this
+                               * line, or a lower bound from a late try; 0 unknown */
+    unsigned char *pending;   /* per line: late last frame, bound the ratio from this frame's load */
+    double *pred;             /* per line: its load predicted one level up */
     int frame;
     double ratio[YP_LOD_MAX]; /* learned load(k + 1) / load(k) */
 };
@@ -72,7 +76,10 @@ hsr_status yp_lod_new(int height, int capacity, yp_lod **out)
     l->prev_issued = malloc(sizeof(int) * (size_t)height);
     l->block = calloc((size_t)height * (YP_LOD_MAX + 1), sizeof(int));
     l->backoff = calloc((size_t)height * (YP_LOD_MAX + 1), sizeof(int));
-    if (!l->lev || !l->prev_lev || !l->prev_issued || !l->block || !l->backoff) { yp_lod_free(l); return HSR_ENOMEM; }
+    l->rl = calloc((size_t)height * (YP_LOD_MAX + 1), sizeof(double));
+    l->pending = calloc((size_t)height, 1);
+    l->pred = calloc((size_t)height, sizeof(double));
+    if (!l->lev || !l->prev_lev || !l->prev_issued || !l->block || !l->backoff || !l->rl || !l->pending || !l->pred) { yp_lod_free(l); return HSR_ENOMEM; }
     memset(l->lev, YP_LOD_MAX, (size_t)height);
     memset(l->prev_lev, YP_LOD_MAX, (size_t)height);
     for (int y = 0; y < height; y++) l->prev_issued[y] = -1;
@@ -84,7 +91,7 @@ hsr_status yp_lod_new(int height, int capacity, yp_lod **out)
 void yp_lod_free(yp_lod *l)
 {
     if (!l) return;
-    free(l->lev); free(l->prev_lev); free(l->prev_issued); free(l->block); free(l->backoff); free(l);
+    free(l->lev); free(l->prev_lev); free(l->prev_issued); free(l->block); free(l->backoff); free(l->rl); free(l->pending); free(l->pred); free(l);
 }
 
 const unsigned char *yp_lod_levels(const yp_lod *l) { return l ? l->lev : NULL; }
@@ -109,13 +116,36 @@ int yp_lod_update(yp_lod *l, const int *issued, const int *late)
         if (cnt[k]) l->ratio[k] = fmax(1.0, 0.5 * l->ratio[k] + 0.5 * sum[k] / cnt[k]);
     int changed = 0;
     for (int y = 0; y < H; y++) {
+        int lv = l->lev[y];
+        double *rl = &l->rl[y * (YP_LOD_MAX + 1)];
+        int pl = l->prev_lev[y], pi = l->prev_issued[y];
+        /* this line's own cost ratios: measured when it moved by one level on time, and
+         * bounded from below when a level was late: the window (capacity + 1) was not
+         * enough for what fitted in `issued` one or two levels down */
+        if (!late[y] && pi > 0 && issued[y] > 0 && !l->pending[y] && abs(pl - lv) == 1)
+            rl[pl < lv ? pl : lv] = pl < lv ? (double)issued[y] / pi : (double)pi / issued[y];
+        if (l->pending[y] && !late[y] && issued[y] > 0 && lv < YP_LOD_MAX)
+            rl[lv] = fmax(rl[lv], (cap + 1) / issued[y]);
+        /* late on its own: the window was full of its words; a line late with fewer words
+         * lost the start of its window to the tail of a late line above it */
+        int own = late[y] && issued[y] >= cap + 1;
+        if (own && pl == lv - 1 && pi > 0)                /* a raise that failed */
+            rl[pl] = fmax(rl[pl], (cap + 1) / pi);
+        l->pending[y] = (unsigned char)own;
+        l->pred[y] = lv < YP_LOD_MAX ? issued[y] * (rl[lv] > 0 ? rl[lv] : l->ratio[lv]) : issued[y];
+    }
+    for (int y = 0; y < H; y++) {
         int lv = l->lev[y], nl = lv;
-        /* the line and its neighbours: what moves vertically brings its load along */
-        int load = issued[y];
-        if (y > 0 && issued[y - 1] > load) load = issued[y - 1];
-        if (y + 1 < H && issued[y + 1] > load) load = issued[y + 1];
         int *bo = &l->backoff[y * (YP_LOD_MAX + 1)], *bl = &l->block[y * (YP_LOD_MAX + 1)];
-        if (late[y]) {
+        int own = late[y] && issued[y] >= cap + 1;
+        /* the load predicted one level up, of the line and of its neighbours (what moves
+         * vertically brings its load along), each at its own cost ratio */
+        double pred = l->pred[y];
+        if (y > 0 && l->pred[y - 1] > pred) pred = l->pred[y - 1];
+        if (y + 1 < H && l->pred[y + 1] > pred) pred = l->pred[y + 1];
+        if (late[y] && !own) {
+            nl = lv > 0 ? lv - 1 : 0;   /* fewer words help it through the shortened window */
+        } else if (late[y]) {
             /* the excess is unknown (a late line's count is its window): two levels down,
              * and this level is not tried again for a while (doubling at each late try) */
             nl = lv >= 2 ? lv - 2 : 0;
@@ -124,7 +154,7 @@ int yp_lod_update(yp_lod *l, const int *issued, const int *late)
             bl[lv] = l->frame + bo[lv];
         } else if (issued[y] > HIGH * cap) {
             nl = lv > 0 ? lv - 1 : 0;
-        } else if (lv < YP_LOD_MAX && load * l->ratio[lv] < RAISE * cap && l->frame >= bl[lv + 1]) {
+        } else if (lv < YP_LOD_MAX && pred < RAISE * cap && l->frame >= bl[lv + 1]) {
             nl = lv + 1;
         } else if (l->frame >= bl[lv] + 4 * bo[lv]) {
             bo[lv] = 0;   /* on time at this level long enough: forget its late tries */
