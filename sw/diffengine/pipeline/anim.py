@@ -216,19 +216,25 @@ def lod_compare(anim_path, out: Path, extra=()) -> dict:
                            capture_output=True, text=True)
         if r.returncode:
             raise RuntimeError(f"yproc anim {' '.join(flags)} failed:\n{r.stderr}")
-        st = json.loads((d / "anim_stats.json").read_text())
-        fr = st["frame"]
-        res[name] = {"overflow_lines": [f["overflow_lines"] for f in fr],
-                     "mean_level": [f["mean_level"] for f in fr],
-                     "max_issued": [max(f["issued"]) for f in fr],
-                     "levels": [f["levels"] for f in fr],
-                     "capacity": st["capacity"], "mean_scan_ms": st["mean_incremental_scan_ms"]}
+        res[name] = lod_run_stats(d)
         print(f"  {name}: overflowing lines per frame {res[name]['overflow_lines']} "
               f"({time.time() - t0:.0f} s)", flush=True)
     (out / "lod.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if kk != "levels"}
                                               for k, v in res.items()}, indent=1) + "\n")
     plot_lod(res, out / "lod.png", Path(anim_path).name)
     return res
+
+
+def lod_run_stats(d: Path) -> dict:
+    """Per frame of one `yproc anim` run (its anim_stats.json): late lines, mean level,
+    the busiest line's count, every line's level; the capacity and the scan time."""
+    st = json.loads((Path(d) / "anim_stats.json").read_text())
+    fr = st["frame"]
+    return {"overflow_lines": [f["overflow_lines"] for f in fr],
+            "mean_level": [f["mean_level"] for f in fr],
+            "max_issued": [max(f["issued"]) for f in fr],
+            "levels": [f["levels"] for f in fr],
+            "capacity": st["capacity"], "mean_scan_ms": st["mean_incremental_scan_ms"]}
 
 
 def plot_lod(res: dict, path, title: str) -> None:
@@ -240,7 +246,8 @@ def plot_lod(res: dict, path, title: str) -> None:
     for name, _, label in LOD_RUNS:
         r = res[name]
         ax[0].plot(r["overflow_lines"], label=label, color=col[name], marker=".")
-        ax[1].plot(r["mean_level"], label=label, color=col[name], marker=".")
+        if name != "ahead":     # the look-ahead lowers patterns inside a line, not line levels
+            ax[1].plot(r["mean_level"], label=label, color=col[name], marker=".")
     ax[0].set_xlabel("frame")
     ax[0].set_ylabel("late (overflowing) lines")
     ax[0].set_title("overflowing lines per frame")

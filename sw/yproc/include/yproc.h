@@ -137,14 +137,16 @@ void yp_lod_free(yp_lod *l);
 const unsigned char *yp_lod_levels(const yp_lod *l);     /* [height], for yp_options.line_lod */
 /* One step of the loop: the previous frame's per-line records (issued, late; the Load
  * Monitor's LINE[l]; for three colours the largest count and any late) -> the next
- * frame's levels (docs/yproc.md section 10).  A line late on its own (its window full)
- * drops two levels, one late because a late line above it shortened its window or
- * above the high-water mark (80 % of the capacity) one; a line is raised one level
- * when the next level's predicted load stays under 70 %: the largest load of it and
- * its two neighbours times the cost ratio learned over all lines, and its own load
- * times its own ratio (measured when it changed level, or bounded from below when a
- * level was late); a level late on its own is also barred for 4 frames, doubling at
- * each late retry.  Returns the lines whose level changed. */
+ * frame's levels (docs/yproc.md section 10).  A line raised last frame and late now
+ * goes back and bars that level; a line late on its own (its window full) drops two
+ * levels and bars the level; one late because a late line above shortened its window,
+ * or above the high-water mark (80 % of the capacity), drops one.  A bar lasts 4
+ * frames, doubling at each late retry, and lifts early when the line's load falls by
+ * 30 %.  A line is raised one level when the next level's predicted load stays under
+ * 70 %: its load times its own cost ratio (measured when it changed level, bounded from
+ * below by late tries; forgotten when its load moves by 30 %) or the ratio learned over
+ * all lines, and the same for its two neighbours.  Returns the lines whose level
+ * changed. */
 int yp_lod_update(yp_lod *l, const int *issued, const int *late);
 
 #endif
