@@ -1,27 +1,59 @@
 #!/usr/bin/env python3
-"""Host side of the board top's UART loader (docs/board.md §3).
+"""Load a scene and its animation into the board over the UART loader (docs/board.md §3).
 
-    de32_load.py /dev/ttyUSB0 red.de32 green.de32 blue.de32 [--base 0] [--shift 0] [--nosat]
-    de32_load.py /dev/ttyUSB0 --status
-    de32_load.py /dev/ttyUSB0 --reg 0x3000
+    de32_load.py PORT SCENE [--anim DIR] [--window W --round] [--resume]
+    de32_load.py PORT r.de32 g.de32 b.de32 [--base 0] [--shift 0] [--nosat]
+    de32_load.py PORT --status | --reg 0x3000
 
-Writes each colour's .de32 words into its frame store at --base (24 words per 'W'
-command, each acknowledged; a command answered 'E' or 'T' is sent again, up to 3 times),
-then the three descriptors ('P': base, length, window and compensation flag from the
-.de32 header), then the 8-bit output window ('O'). The descriptors take effect at the
-next frame each, so load a new image at another base to switch without tearing.
-Needs only the standard library (termios); 115200 baud 8N1, as the bitstream is built.
+SCENE is what `make demo` writes (a directory with r/g/b .de48 streams, e.g.
+out/demo_cmd) or three r g b files (.de32 frame-store images or .de48 streams);
+--anim adds every frame of a `make anim` output directory (frame000/ and the
+frameNNN.delta files). Each frame's three colours are stored one after the other in
+each colour's frame store from --base; the descriptors ('P') then show frame --show
+(default 0), and the output window ('O') is set. .de48 streams are turned into
+frame-store words at DAC window --window; with --round, operands are rounded to that
+window's grid (otherwise a value the frame store cannot hold is an error naming the
+file and slot).
+
+Link: 3,000,000 baud 8N1 (--baud), the FT231X's maximum, as the bitstream is built.
+Every packet is answered: 'K' next packet; 'E' (checksum or field error) or 'T' (the
+board abandoned an incomplete command) or no reply within the timeout: wait until the
+board has abandoned any partial command, flush, re-send the same packet (writes are
+idempotent), up to --retries times. After each acknowledged packet the state file
+(--state) records how far the load got; if the link drops or the retries run out, the
+tool stops with status 2 and `--resume` (same arguments) restarts from the last
+acknowledged packet. On a terminal a progress bar shows bytes, rate and ETA; otherwise
+a progress line is printed every 5 s.
+Needs only the standard library for .de32 files (termios); .de48 and animations use
+diffengine.formats (sw/).
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
 import os
+import select
 import struct
 import sys
 import termios
 import time
+from pathlib import Path
+
+BAUD = 3_000_000
+ABANDON_S = 0.3          # > the loader's 2^22 pixel clocks (168 ms) of idle timeout
+PACKET_WORDS = 256       # words per 'W' (the count field is 16 bits)
 
 
+class LoadError(Exception):
+    """Bad input or a failed load; the message names the file (and line/slot/byte)."""
+
+
+class LinkDropped(LoadError):
+    pass
+
+
+# ---------------------------------------------------------------------------- packets
 def with_chk(body: bytes) -> bytes:
     return body + bytes([(-sum(body)) & 0xFF])
 
@@ -35,75 +67,393 @@ def cmd_p(ch: int, base: int, n: int, window: int, comp: bool) -> bytes:
     return with_chk(b"P" + bytes([ch]) + struct.pack(">HHBB", base, n, window, int(comp)))
 
 
-def read_de32(path: str) -> tuple[list[int], int, bool]:
-    data = open(path, "rb").read()
-    if data[:4] != b"DE32" or len(data) < 8 or (len(data) - 8) % 4:
-        sys.exit(f"{path}: not a .de32 file (docs/formats.md §3)")
+def cmd_o(shift: int, sat: bool) -> bytes:
+    return with_chk(b"O" + bytes([shift, int(sat)]))
+
+
+# ---------------------------------------------------------------------------- inputs
+Image = tuple  # (words, window, compensate)
+
+
+def read_de32(path: str) -> Image:
+    data = Path(path).read_bytes()
+    if data[:4] != b"DE32":
+        raise LoadError(f"{path}:byte 0: not a .de32 file (docs/formats.md §3)")
+    if len(data) < 8 or (len(data) - 8) % 4:
+        raise LoadError(f"{path}:byte {len(data)}: truncated .de32 (header 8 bytes, then "
+                        "4-byte words)")
+    if data[6] > 4:
+        raise LoadError(f"{path}:byte 6: window {data[6]} outside 0..4")
     n = (len(data) - 8) // 4
     return list(struct.unpack(f">{n}I", data[8:])), data[6], bool(data[7] & 1)
 
 
+def round_slot(ident: int, data: int, window: int) -> int:
+    """The 36-bit data of a slot rounded to the nearest value the frame store holds."""
+    from diffengine import isa
+    typ = isa.ID_TYPE[ident]
+    if typ == isa.TYPE_ADDR:
+        b2 = data >> 24
+        v = b2 - (1 << 12) if b2 & 0x800 else b2
+        q = max(-64, min(63, (v + (1 << window >> 1)) >> window))
+        return (data & 0xFFFFFF) | ((q << window) & 0xFFF) << 24
+    if typ != isa.TYPE_NONE:
+        low = 4 + window
+        q = (isa.to_signed(data) + (1 << (low - 1))) >> low
+        q = max(-(1 << 26), min((1 << 26) - 1, q))
+        return isa.to_word(q << low)
+    return data
+
+
+def de48_image(data: bytes, name: str, window: int, rnd: bool) -> Image:
+    """A .de48 stream -> frame-store words at `window` (docs/formats.md §3)."""
+    from diffengine import isa
+    from diffengine.formats import binfmt
+    from diffengine.formats.asm import AsmError
+    try:
+        slots = binfmt.decode_de48(data, name)
+    except AsmError as e:
+        raise LoadError(str(e)) from None
+    words = []
+    for k, (ident, d) in enumerate(slots):
+        if rnd:
+            d = round_slot(ident, d, window)
+        try:
+            words.append(isa.LUT_INDEX[ident] << binfmt.OPERAND_BITS
+                         | binfmt._fs_operand(ident, d, window))
+        except (ValueError, KeyError) as e:
+            raise LoadError(f"{name}:slot {k}: {e} (give --round, or another --window)") \
+                from None
+    return words, window, False
+
+
+def read_image(path: str, window: int | None, rnd: bool) -> Image:
+    head = Path(path).read_bytes()[:4]
+    if head == b"DE32":
+        return read_de32(path)
+    if head == b"DE48":
+        if window is None:
+            raise LoadError(f"{path}:byte 0: a .de48 stream needs --window (0..4)")
+        return de48_image(Path(path).read_bytes(), path, window, rnd)
+    raise LoadError(f"{path}:byte 0: neither .de32 nor .de48 (docs/formats.md)")
+
+
+def read_scene(paths: list[str], window, rnd) -> list[Image]:
+    if len(paths) == 1 and Path(paths[0]).is_dir():
+        d = Path(paths[0])
+        files = []
+        for c in "rgb":
+            f = next((d / f"{c}{s}" for s in (".de32", ".de48") if (d / f"{c}{s}").exists()),
+                     None)
+            if f is None:
+                raise LoadError(f"{d}: no {c}.de32 or {c}.de48 (make demo writes out/demo_cmd)")
+            files.append(str(f))
+        paths = files
+    if len(paths) != 3:
+        raise LoadError("give a scene directory or three files: red green blue")
+    return [read_image(p, window, rnd) for p in paths]
+
+
+def read_anim(d: str, window, rnd) -> list[list[Image]]:
+    from diffengine.pipeline import anim
+    if window is None:
+        raise LoadError(f"{d}: an animation's .de48 streams need --window (0..4)")
+    if not (Path(d) / "frame000").is_dir():
+        raise LoadError(f"{d}: no frame000/ (make anim writes out/anim)")
+    try:
+        seq = anim.frames(d)
+    except ValueError as e:
+        raise LoadError(str(e)) from None
+    return [[de48_image(anim.to_de48(ch), f"{d}/frame{f:03d} {'rgb'[c]}", window, rnd)
+             for c, ch in enumerate(fr)] for f, fr in enumerate(seq)]
+
+
+# ---------------------------------------------------------------------------- the plan
+def plan_packets(frames: list[list[Image]], base: int, words: int, show: int,
+                 shift: int, sat: bool, fs_words: int | None):
+    """Every packet in order, and the frame layout [(frame, colour, base, n)]."""
+    pkts, layout = [], []
+    nxt = [base] * 3
+    for f, fr in enumerate(frames):
+        for c, (w, _, _) in enumerate(fr):
+            layout.append((f, c, nxt[c], len(w)))
+            nxt[c] += len(w)
+    top = max(nxt)
+    if top > 0x10000:
+        raise LoadError(f"the frames need {top} words per colour; the loader's 'W' address "
+                        "is 16 bits (65,536 words): the SDRAM store needs the wider write of "
+                        "docs/board.md §3")
+    if fs_words is not None and top > fs_words:
+        raise LoadError(f"the frames need {top} words per colour; the board's frame store "
+                        f"holds {fs_words}")
+    for f, c, b, n in layout:
+        w = frames[f][c][0]
+        for k in range(0, n, words):
+            pkts.append(cmd_w(c, b + k, w[k:k + words]))
+    if not 0 <= show < len(frames):
+        raise LoadError(f"--show {show}: there are {len(frames)} frames")
+    for f, c, b, n in layout:
+        if f == show:
+            _, window, comp = frames[f][c]
+            pkts.append(cmd_p(c, b, n, window, comp))
+    pkts.append(cmd_o(shift, sat))
+    return pkts, layout
+
+
+def plan_hash(pkts: list[bytes]) -> str:
+    h = hashlib.sha256()
+    for p in pkts:
+        h.update(p)
+    return h.hexdigest()
+
+
+class State:
+    """The small state file: which load (plan hash) and how many packets are acknowledged."""
+
+    def __init__(self, path: str, digest: str, n: int):
+        self.path, self.digest, self.n = path, digest, n
+        self.acked = 0
+        self._saved = 0.0
+
+    def load(self) -> int:
+        try:
+            text = Path(self.path).read_text()
+        except FileNotFoundError:
+            raise LoadError(f"{self.path}: no state file to resume from") from None
+        try:
+            st = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise LoadError(f"{self.path}:{e.lineno}: {e.msg}") from None
+        if st.get("plan") != self.digest or st.get("packets") != self.n:
+            raise LoadError(f"{self.path}:1: written for another load (other files or "
+                            "options); run without --resume")
+        a = st.get("acked")
+        if not isinstance(a, int) or not 0 <= a <= self.n:
+            raise LoadError(f"{self.path}:1: bad 'acked' {a!r}")
+        self.acked = a
+        return a
+
+    def save(self, force: bool = False) -> None:
+        now = time.monotonic()
+        if not force and now - self._saved < 0.5:
+            return
+        tmp = self.path + ".tmp"
+        Path(tmp).write_text(json.dumps({"version": 1, "plan": self.digest,
+                                         "packets": self.n, "acked": self.acked}) + "\n")
+        os.replace(tmp, self.path)
+        self._saved = now
+
+
+# ---------------------------------------------------------------------------- the link
 class Port:
-    def __init__(self, dev: str, baud: int = 115200):
-        self.fd = os.open(dev, os.O_RDWR | os.O_NOCTTY)
-        attr = termios.tcgetattr(self.fd)
-        speed = getattr(termios, f"B{baud}")
-        attr[0] = 0                                   # iflag: raw
-        attr[1] = 0                                   # oflag
-        attr[2] = termios.CS8 | termios.CREAD | termios.CLOCAL
-        attr[3] = 0                                   # lflag: no echo, non-canonical
-        attr[4] = attr[5] = speed
-        attr[6][termios.VMIN] = 0
-        attr[6][termios.VTIME] = 5                    # 0.5 s read timeout
-        termios.tcsetattr(self.fd, termios.TCSANOW, attr)
-        termios.tcflush(self.fd, termios.TCIOFLUSH)
+    """A serial port (or pty / socket: any file descriptor) in raw 8N1."""
 
-    def command(self, data: bytes, n_reply: int = 1, tries: int = 3) -> bytes:
-        for _ in range(tries):
-            os.write(self.fd, data)
-            got = b""
-            deadline = time.time() + 1.0 + len(data) * 10 / 115200
-            while len(got) < n_reply and time.time() < deadline:
-                got += os.read(self.fd, n_reply - len(got))
-            if got[:1] in (b"K", b"R", b"S") and len(got) == n_reply:
-                return got
-            time.sleep(0.3)                           # let an abandoned command time out
-            termios.tcflush(self.fd, termios.TCIFLUSH)
-        sys.exit(f"command {data[:1]!r} failed after {tries} tries (last reply {got!r})")
+    def __init__(self, dev: str | int, baud: int = BAUD):
+        self.fd = dev if isinstance(dev, int) else os.open(dev, os.O_RDWR | os.O_NOCTTY)
+        self.baud = baud
+        if os.isatty(self.fd):
+            attr = termios.tcgetattr(self.fd)
+            speed = getattr(termios, f"B{baud}", None)
+            if speed is None:
+                raise LoadError(f"--baud {baud}: not a termios speed on this system")
+            attr[0] = 0                                   # iflag: raw
+            attr[1] = 0                                   # oflag
+            attr[2] = termios.CS8 | termios.CREAD | termios.CLOCAL
+            attr[3] = 0                                   # lflag: no echo, non-canonical
+            attr[4] = attr[5] = speed
+            attr[6][termios.VMIN] = 0
+            attr[6][termios.VTIME] = 0
+            termios.tcsetattr(self.fd, termios.TCSANOW, attr)
+            termios.tcflush(self.fd, termios.TCIOFLUSH)
+
+    def write(self, data: bytes) -> None:
+        try:
+            while data:
+                n = os.write(self.fd, data)
+                data = data[n:]
+        except OSError as e:
+            raise LinkDropped(f"link dropped while sending ({e.strerror})") from None
+
+    def read(self, n: int, timeout: float) -> bytes:
+        got, end = b"", time.monotonic() + timeout
+        while len(got) < n:
+            left = end - time.monotonic()
+            if left <= 0:
+                break
+            r, _, _ = select.select([self.fd], [], [], left)
+            if not r:
+                break
+            try:
+                b = os.read(self.fd, n - len(got))
+            except OSError as e:
+                raise LinkDropped(f"link dropped while waiting for a reply ({e.strerror})") \
+                    from None
+            if not b:
+                raise LinkDropped("link dropped while waiting for a reply (end of file)")
+            got += b
+        return got
+
+    def drain(self) -> None:
+        while self.read(4096, 0.0):
+            pass
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("port")
-    ap.add_argument("images", nargs="*", help="red, green, blue .de32 files")
-    ap.add_argument("--base", type=lambda s: int(s, 0), default=0)
+class Loader:
+    def __init__(self, port: Port, retries: int = 5, abandon: float = ABANDON_S,
+                 log=None):
+        self.port, self.retries, self.abandon = port, retries, abandon
+        self.resent = 0
+        self.log = log or (lambda msg: None)
+
+    def command(self, pkt: bytes, n_reply: int = 1) -> bytes:
+        want = {ord("R"): b"R", ord("S"): b"S"}.get(pkt[0], b"K")
+        timeout = 0.2 + len(pkt) * 10 / self.port.baud
+        last = b""
+        for t in range(self.retries + 1):
+            if t:
+                self.resent += 1
+                self.log(f"packet {chr(pkt[0])} re-sent (try {t + 1}): "
+                         f"{'no reply' if not last else 'reply ' + repr(last)}")
+                time.sleep(self.abandon)              # a partial command is abandoned
+                self.port.drain()
+            self.port.write(pkt)
+            last = self.port.read(n_reply, timeout)
+            if last[:1] == want and len(last) == n_reply:
+                return last
+        raise LoadError(f"packet {chr(pkt[0])} failed after {self.retries + 1} tries "
+                        f"(last reply {last!r})")
+
+
+class Progress:
+    def __init__(self, total: int, stream=sys.stderr, start: int = 0):
+        self.total, self.stream, self.done = total, stream, start
+        self.t0, self.d0 = time.monotonic(), start
+        self.tty = hasattr(stream, "isatty") and stream.isatty()
+        self._last = 0.0
+
+    def line(self) -> str:
+        dt = max(time.monotonic() - self.t0, 1e-9)
+        rate = (self.done - self.d0) / dt
+        eta = (self.total - self.done) / rate if rate > 0 else float("inf")
+        frac = self.done / self.total if self.total else 1.0
+        bar = "#" * int(frac * 30)
+        eta_s = "--:--" if eta == float("inf") else f"{int(eta) // 60}:{int(eta) % 60:02d}"
+        return (f"[{bar:<30}] {frac * 100:5.1f}% {self.done / 1e3:,.1f}/{self.total / 1e3:,.1f} kB "
+                f"{rate / 1e3:,.1f} kB/s ETA {eta_s}")
+
+    def update(self, n: int) -> None:
+        self.done += n
+        now = time.monotonic()
+        if now - self._last < (0.1 if self.tty else 5.0):
+            return
+        self._last = now
+        self.stream.write(("\r" + self.line()) if self.tty else self.line() + "\n")
+        self.stream.flush()
+
+    def finish(self) -> None:
+        self.stream.write(("\r" + self.line() + "\n") if self.tty else self.line() + "\n")
+        self.stream.flush()
+
+
+def run_plan(loader: Loader, pkts: list[bytes], state: State, start: int,
+             stream=sys.stderr) -> None:
+    total = sum(len(p) for p in pkts)
+    prog = Progress(total, stream, start=sum(len(p) for p in pkts[:start]))
+    state.acked = start
+    try:
+        for k in range(start, len(pkts)):
+            loader.command(pkts[k])
+            state.acked = k + 1
+            state.save()
+            prog.update(len(pkts[k]))
+    finally:
+        state.save(force=True)
+    prog.finish()
+
+
+# ---------------------------------------------------------------------------- main
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 epilog=__doc__.split("\n\n", 2)[2],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("port", help="serial device (/dev/ttyUSB0) of the board's FT231X")
+    ap.add_argument("scene", nargs="*", help="scene directory, or r g b files (.de32/.de48)")
+    ap.add_argument("--anim", help="make anim output directory: load all its frames too")
+    ap.add_argument("--window", type=int, choices=range(5), help="DAC window for .de48")
+    ap.add_argument("--round", action="store_true", help="round .de48 operands to the window")
+    ap.add_argument("--base", type=lambda s: int(s, 0), default=0, help="first word (0)")
+    ap.add_argument("--show", type=int, default=0, help="frame the descriptors show (0)")
     ap.add_argument("--shift", type=int, default=0, help="8-bit output window [shift+7:shift]")
     ap.add_argument("--nosat", action="store_true", help="wrap instead of clamping")
-    ap.add_argument("--status", action="store_true")
-    ap.add_argument("--reg", type=lambda s: int(s, 0))
-    a = ap.parse_args()
-    port = Port(a.port)
-    if a.images:
-        if len(a.images) != 3:
-            sys.exit("give three .de32 files: red green blue")
-        imgs = [read_de32(p) for p in a.images]
-        for ch, (words, _, _) in enumerate(imgs):
-            for k in range(0, len(words), 24):
-                port.command(cmd_w(ch, a.base + k, words[k:k + 24]))
-        for ch, (words, window, comp) in enumerate(imgs):
-            port.command(cmd_p(ch, a.base, len(words), window, comp))
-        port.command(with_chk(b"O" + bytes([a.shift, 0 if a.nosat else 1])))
-        print(f"loaded {[len(w) for w, _, _ in imgs]} words at base {a.base}")
-    if a.status:
-        s = port.command(with_chk(b"S"), 16)
-        f = struct.unpack(">HHHH", s[4:12])
-        print(f"version {s[1]} chips/colour {s[2]} frame store 2^{s[3]} words; errors: "
-              f"framing {f[0]} checksum {f[1]} command {f[2]}; frames {f[3]}; "
-              f"flags {s[12]:#04x} (bit0 align_err, 1-3 collision, 4-6 pending); "
-              f"output shift {s[13] & 7} sat {s[13] >> 3 & 1}")
-    if a.reg is not None:
-        r = port.command(with_chk(b"R" + struct.pack(">H", a.reg)), 5)
-        print(f"reg {a.reg:#06x} = {struct.unpack('>I', r[1:])[0]:#010x}")
+    ap.add_argument("--words", type=int, default=PACKET_WORDS,
+                    help=f"words per 'W' packet, 1..65535 ({PACKET_WORDS})")
+    ap.add_argument("--baud", type=int, default=BAUD, help=f"({BAUD})")
+    ap.add_argument("--retries", type=int, default=5, help="re-sends per packet (5)")
+    ap.add_argument("--abandon", type=float, default=ABANDON_S,
+                    help=f"seconds the board needs to abandon a partial command ({ABANDON_S})")
+    ap.add_argument("--state", default="de32_load.state.json", help="state file for --resume")
+    ap.add_argument("--resume", action="store_true", help="continue an interrupted load")
+    ap.add_argument("--no-size-check", action="store_true",
+                    help="do not ask the board ('S') for its frame-store size first")
+    ap.add_argument("--status", action="store_true", help="print the board's status")
+    ap.add_argument("--reg", type=lambda s: int(s, 0), help="read a controller register")
+    return ap
+
+
+def main(argv=None, port_fd: int | None = None) -> int:
+    a = build_parser().parse_args(argv)
+    if not 1 <= a.words <= 0xFFFF:
+        print(f"de32_load: --words {a.words} outside 1..65535", file=sys.stderr)
+        return 1
+    try:
+        frames = []
+        if a.scene:
+            frames.append(read_scene(a.scene, a.window, a.round))
+        if a.anim:
+            frames += read_anim(a.anim, a.window, a.round)
+        port = Port(port_fd if port_fd is not None else a.port, a.baud)
+        loader = Loader(port, a.retries, a.abandon,
+                        log=lambda m: print(f"\nde32_load: {m}", file=sys.stderr))
+        if frames:
+            fs_words = None
+            if not a.no_size_check:
+                st = loader.command(with_chk(b"S"), 16)
+                fs_words = 1 << st[3]
+            pkts, layout = plan_packets(frames, a.base, a.words, a.show, a.shift,
+                                        not a.nosat, fs_words)
+            state = State(a.state, plan_hash(pkts), len(pkts))
+            start = state.load() if a.resume else 0
+            if start == len(pkts):
+                print(f"de32_load: {a.state}: this load is already complete", file=sys.stderr)
+            else:
+                if start:
+                    print(f"de32_load: resuming at packet {start} of {len(pkts)}",
+                          file=sys.stderr)
+                run_plan(loader, pkts, state, start)
+            print(f"loaded {len(frames)} frame(s), {len(pkts)} packets, "
+                  f"{loader.resent} re-sent; words per colour "
+                  f"{[sum(n for f, c, b, n in layout if c == ch) for ch in range(3)]} "
+                  f"from base {a.base}; showing frame {a.show}")
+        if a.status:
+            s = loader.command(with_chk(b"S"), 16)
+            f = struct.unpack(">HHHH", s[4:12])
+            print(f"version {s[1]} chips/colour {s[2]} frame store 2^{s[3]} words; errors: "
+                  f"framing {f[0]} checksum {f[1]} command {f[2]}; frames {f[3]}; "
+                  f"flags {s[12]:#04x} (bit0 align_err, 1-3 collision, 4-6 pending); "
+                  f"output shift {s[13] & 7} sat {s[13] >> 3 & 1}")
+        if a.reg is not None:
+            r = loader.command(with_chk(b"R" + struct.pack(">H", a.reg)), 5)
+            print(f"reg {a.reg:#06x} = {struct.unpack('>I', r[1:])[0]:#010x}")
+    except LinkDropped as e:
+        print(f"\nde32_load: {e}; run again with --resume (state in {a.state})",
+              file=sys.stderr)
+        return 2
+    except LoadError as e:
+        print(f"\nde32_load: {e}", file=sys.stderr)
+        return 2 if "failed after" in str(e) else 1
+    except OSError as e:
+        print(f"de32_load: {e.filename or a.port}: {e.strerror}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -1,14 +1,14 @@
 // Board top of the Difference Engine prototype, portable core (docs/board.md).
 //
-//   uart_rx_i -> de_uart_rx -> de_loader -+-> frame store R -> player R -+
+//   uart_rx_i -> de_uart_link -> de_loader -+-> frame store R -> player R -+
 //                                          +-> frame store G -> player G -+-> display_controller
-//   uart_tx_o <- de_uart_tx <-------------+-> frame store B -> player B -+   (3 arrays, NumBuf 1)
+//   uart_tx_o <- de_uart_link <-----------+-> frame store B -> player B -+   (3 arrays, NumBuf 1)
 //                                                                          |
 //   tmds_o[2:0] <- de_tmds_enc x 3 <- rgb8 / hsync / vsync / blank <-------+
 //
-// One clock domain, the pixel clock (clk_i), plus clk_core_i for the span-serial arrays
-// when SpanArray = 1 (9 * NumChips columns each in block RAM, docs/fpga.md 3; unused
-// otherwise). The board shell (fpga/ulx3s/) adds the PLL, the 10:1 serialisers and the
+// The pixel clock (clk_i), plus clk_core_i for the UART (always: 3 Mbaud needs a clock
+// with an integer bit period, de_uart_link) and for the span-serial arrays when
+// SpanArray = 1 (9 * NumChips columns each in block RAM, docs/fpga.md 3). The board shell (fpga/ulx3s/) adds the PLL, the 10:1 serialisers and the
 // pins. Colour: one frame store, one player and one
 // instruction buffer per colour (the display controller's one-buffer-per-colour
 // choice, docs/display-controller.md §9.1); each player is the single y-processor of
@@ -20,7 +20,8 @@ module de_board_core #(
   parameter int unsigned NumChips    = 1,      // chips of 9 PEs per colour array
   parameter int unsigned CarryBug    = 0,
   parameter int unsigned FsDepth     = 1024,   // frame-store words per colour
-  parameter int unsigned ClkPerBit   = 217,    // UART: 25 MHz / 115200 baud
+  parameter int unsigned UartClkHz   = 78_125_000,  // UART on clk_core_i (de_uart_link)
+  parameter int unsigned Baud        = 3_000_000,   // FT231X maximum; divider 26, 0.16 %
   parameter int unsigned TimeoutBits = 22,
   parameter int unsigned BufDepth    = 16,
   parameter int unsigned MaxLines    = 512,
@@ -67,14 +68,10 @@ module de_board_core #(
   logic [NumCh-1:0] frame;   // G and B play in lockstep with R; R's count is reported
   /* verilator lint_on UNUSEDSIGNAL */
 
-  de_uart_rx #(.ClkPerBit(ClkPerBit)) u_rx (
-    .clk_i, .rst_i, .rx_i(uart_rx_i),
-    .valid_o(rx_valid), .data_o(rx_data), .frame_err_o(rx_ferr)
-  );
-
-  de_uart_tx #(.ClkPerBit(ClkPerBit)) u_tx (
-    .clk_i, .rst_i, .valid_i(tx_valid), .ready_o(tx_ready), .data_i(tx_data),
-    .tx_o(uart_tx_o)
+  de_uart_link #(.ClkHz(UartClkHz), .Baud(Baud)) u_uart (
+    .clk_i, .rst_i, .clk_uart_i(clk_core_i), .rx_i(uart_rx_i), .tx_o(uart_tx_o),
+    .rx_valid_o(rx_valid), .rx_ferr_o(rx_ferr), .rx_data_o(rx_data),
+    .tx_valid_i(tx_valid), .tx_ready_o(tx_ready), .tx_data_i(tx_data)
   );
 
   de_loader #(

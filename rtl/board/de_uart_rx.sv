@@ -1,24 +1,39 @@
 // UART receiver of the board top (8N1, LSB first), docs/board.md §3.
 //
-// The line is synchronised by two flip-flops, a start bit is confirmed at its middle and
-// every bit is sampled at its middle (ClkPerBit clocks apart). A stop bit that reads 0
-// is a framing error: the byte is not delivered, frame_err_o pulses for one clock, and
-// the receiver waits for the line to return to idle (1) before it looks for the next
-// start bit, so a break or a wrong baud rate yields errors, not garbage bytes.
+// The bit period is ClkHz / Baud rounded to an integer number of clocks; elaboration
+// fails unless that divider is within 2 % of the exact period, because the receiver
+// samples every bit once, at its middle, and an 8N1 frame tolerates about 5 % of total
+// rate mismatch between the two ends (half a bit over 9.5 bits), which the host's own
+// baud-rate error must share.
+//
+// The line is synchronised by two flip-flops. A falling edge starts a start bit; if the
+// line returns to 1 at any clock of the start bit's first half, it was a glitch and the
+// receiver goes back to idle (start-bit glitch rejection). Every bit is then sampled at
+// its middle, ClkPerBit clocks apart. A stop bit that reads 0 is a framing error: the
+// byte is not delivered, frame_err_o pulses for one clock, and the receiver waits for
+// the line to return to idle (1) before it looks for the next start bit, so a break or
+// a wrong baud rate yields errors, not garbage bytes.
 `default_nettype none
 
 module de_uart_rx #(
-  parameter int unsigned ClkPerBit = 217   // 25 MHz / 115200 baud
+  parameter int unsigned ClkHz = 78_125_000,
+  parameter int unsigned Baud  = 3_000_000,
+  localparam int unsigned ClkPerBit = de_uart_pkg::clk_per_bit(ClkHz, Baud),
+  localparam longint unsigned ErrPm = de_uart_pkg::err_permille(ClkHz, Baud)
 ) (
   input  logic       clk_i,
   input  logic       rst_i,
   input  logic       rx_i,
   output logic       valid_o,      // one clock per received byte
-  output logic [7:0] data_o,
-  output logic       frame_err_o   // one clock per framing error
+  output logic       frame_err_o,  // one clock per framing error
+  output logic [7:0] data_o
 );
-  if (ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
-    $fatal(1, "de_uart_rx: ClkPerBit must be 4..65535");
+  if (Baud == 0 || ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
+    $fatal(1, "de_uart_rx: ClkHz / Baud must give 4..65535 clocks per bit");
+  end
+  if (ErrPm >= 20) begin : g_bad_rate
+    $fatal(1, "de_uart_rx: the integer bit period ClkHz/Baud is off by 2 %% or more, ",
+           "so mid-bit sampling would drift out of the bit within one 8N1 frame");
   end
 
   typedef enum logic [2:0] {SIdle, SStart, SData, SStop, SBreak} state_e;
@@ -45,15 +60,15 @@ module de_uart_rx #(
         end
       end
       SStart: begin
-        if (cnt_q != 16'd0) begin
+        if (rx_q2) begin
+          state_d = SIdle;   // back to 1 before the middle of the start bit: a glitch
+        end else if (cnt_q != 16'd0) begin
           cnt_d = cnt_q - 16'd1;
-        end else if (!rx_q2) begin
-          // Still low in the middle of the start bit: a real start bit.
+        end else begin
+          // Low for the whole first half of the start bit: a real start bit.
           state_d = SData;
           cnt_d   = 16'(ClkPerBit - 1);
           bit_d   = 3'd0;
-        end else begin
-          state_d = SIdle;   // a glitch
         end
       end
       SData: begin

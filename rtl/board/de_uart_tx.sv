@@ -1,8 +1,12 @@
-// UART transmitter of the board top (8N1, LSB first): the loader's replies.
+// UART transmitter of the board top (8N1, LSB first): the loader's replies. The bit
+// period is ClkHz / Baud rounded; elaboration fails at 2 % error or more (de_uart_pkg).
 `default_nettype none
 
 module de_uart_tx #(
-  parameter int unsigned ClkPerBit = 217
+  parameter int unsigned ClkHz = 78_125_000,
+  parameter int unsigned Baud  = 3_000_000,
+  localparam int unsigned ClkPerBit = de_uart_pkg::clk_per_bit(ClkHz, Baud),
+  localparam longint unsigned ErrPm = de_uart_pkg::err_permille(ClkHz, Baud)
 ) (
   input  logic       clk_i,
   input  logic       rst_i,
@@ -11,8 +15,12 @@ module de_uart_tx #(
   input  logic [7:0] data_i,
   output logic       tx_o
 );
-  if (ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
-    $fatal(1, "de_uart_tx: ClkPerBit must be 4..65535");
+  if (Baud == 0 || ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
+    $fatal(1, "de_uart_tx: ClkHz / Baud must give 4..65535 clocks per bit");
+  end
+  if (ErrPm >= 20) begin : g_bad_rate
+    $fatal(1, "de_uart_tx: the integer bit period ClkHz/Baud is off by 2 %% or more, ",
+           "so the far end's mid-bit sampling would drift out of the bit within one frame");
   end
 
   logic [9:0]  sh_d, sh_q;      // {stop, data, start}, shifted out LSB first

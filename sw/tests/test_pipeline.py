@@ -19,9 +19,8 @@ import numpy as np
 import pytest
 
 from diffengine.pipeline import anim, demo as pipeline
-from diffengine.rtl import dc_harness
 from diffengine.formats import frame
-from diffengine.model import functional, reference
+from diffengine.model import reference
 from scene_files import scene_copy
 
 REPO = Path(__file__).resolve().parents[2]
@@ -129,18 +128,11 @@ def test_animation_deltas_equal_full_rerender(tmp_path):
         assert streams == full, f"frame {f}: deltas applied != full re-render"
         if f:
             changed += sum(a != b for c in range(3) for a, b in zip(seq[f][c], seq[f - 1][c]))
-        g = np.stack([functional.render(anim.binfmt.load_commands(anim.to_de48(full[c]),
-                                                                  "x")[0], W)
-                      for c in range(3)], -1)
-        gold.append(g)
+        gold.append(anim.golden_frame(full, W))
     assert changed > 30                                   # the deltas carry real changes
     assert not (gold[0] == gold[-1]).all()
     # the RTL, fed the incremental streams of all 30 frames one after the other
-    cfg = dc_harness.Config(chips=CHIPS, test=pipeline.controller_setup(W, H, CHIPS)[1])
-    streams = [tmp_path / f"{c}.de48" for c in "rgb"]
-    for c in range(3):
-        streams[c].write_bytes(anim.to_de48([ln for fr in seq for ln in fr[c]]))
-    frames, st = dc_harness.run(streams, cfg, mode=3)
+    frames, st = anim.play_rtl(seq, W, H, CHIPS, tmp_path)
     assert frames.shape[0] == 30 and st["load_monitor"]["R"]["total_late_lines"] == 0
     for f in range(30):
         np.testing.assert_array_equal(frames[f], gold[f], err_msg=f"frame {f}")

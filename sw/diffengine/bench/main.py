@@ -20,6 +20,7 @@ BENCHES = [
     ("recon", ".recon", "image reconstruction report -> docs/reconstruction.md"),
     ("recon-images", ".recon_images", "the reconstruction test images -> sw/images"),
     ("viewer", ".viewer", "viewer: pointer-to-frame latency of a scripted drag (teapot, CAD)"),
+    ("link", ".link", "UART link: host tool + loader model through a pty, teapot budget"),
     ("render", ".render", "docs/performance.md sections from docs/bench/*.json"),
 ]
 

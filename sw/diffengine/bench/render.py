@@ -28,6 +28,7 @@ SECTIONS = {
     "yproc-scaling": (".yproc", "render_scaling"),
     "span": (".span", "render"),
     "viewer": (".viewer", "render"),
+    "link": (".link", "render"),
 }
 
 

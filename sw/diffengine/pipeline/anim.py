@@ -102,6 +102,9 @@ itself re-renders every frame in full and compares the streams (its
 `frames_differing_from_full` must be 0, checked here); this script also checks that the
 image updated line by line equals a from-scratch render of the last frame by the numpy
 golden model (diffengine.model.functional, the reference).
+It also writes changed.json / changed.png: the instructions changed per scanline per
+frame (the slots of each new line not on the longest common subsequence of its commands
+with the previous frame's line, counted by yproc), as a histogram and per frame.
 
     diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim] [--model fast|numpy]
 
@@ -115,6 +118,158 @@ def render_lines(lines: list[bytes], width: int) -> np.ndarray:
     return functional.render(cmds, width)
 
 
+def golden_frame(streams: list[list[bytes]], width: int) -> np.ndarray:
+    """One frame (three colours' lines) through the golden model: (H, W, 3)."""
+    return np.stack([render_lines(streams[c], width) for c in range(3)], axis=-1)
+
+
+def play_rtl(seq: list[list[list[bytes]]], width: int, height: int, chips: int,
+             workdir: Path, test: tuple | None = None) -> tuple[np.ndarray, dict]:
+    """Every frame of `seq` (frames()) one after the other through the Verilated display
+    controller in test mode (diffengine.rtl.dc_harness); `test`: the geometry (default
+    demo.controller_setup's, HTotal 800). Returns (frames (F, H, W, 3), harness stats)."""
+    from ..rtl import dc_harness
+    from .demo import controller_setup
+    cfg = dc_harness.Config(chips=chips, test=test or controller_setup(width, height, chips)[1])
+    paths = [Path(workdir) / f"rtl_{c}.de48" for c in "rgb"]
+    for c in range(3):
+        paths[c].write_bytes(to_de48([ln for fr in seq for ln in fr[c]]))
+    return dc_harness.run(paths, cfg, mode=3)
+
+
+def changed_histogram(st: dict, lines: list | None = None) -> dict:
+    """Changed instructions per scanline per frame from `anim_stats.json` (`changed_slots`:
+    per frame, colour and line, the instruction slots of the new line that are not on the
+    longest common subsequence of its commands with the previous frame's line; 0 for a
+    line that did not change). `lines`: the frames' streams (frames()), for the slots per
+    line. Returns per frame the median / 90th percentile / max over the 3 x H lines, the
+    count of lines that changed, and a histogram over every (frame >= 1, colour, line)."""
+    per = [f for f in st["frame"][1:] if "changed_slots" in f]
+    if not per:
+        return {}
+    cs = np.array([f["changed_slots"] for f in per])            # (F-1, 3, H)
+    flat = cs.reshape(len(per), -1)
+    edges = [0, 1, 3, 6, 11, 21, 41, 81, 161, 10 ** 9]
+    hist = np.histogram(flat.ravel(), bins=edges)[0]
+    out = {
+        "frames": [f["frame"] for f in per],
+        "median": np.median(flat, axis=1).tolist(),
+        "p90": np.percentile(flat, 90, axis=1).tolist(),
+        "max": flat.max(axis=1).tolist(),
+        "changed_lines": (flat > 0).sum(axis=1).tolist(),
+        "bins": [f"{a}-{b - 1}" if b - 1 > a else f"{a}" for a, b in zip(edges[:-2], edges[1:-1])] + [f">={edges[-2]}"],
+        "hist": hist.tolist(),
+        "median_all": float(np.median(flat)),
+        "median_changed_lines": float(np.median(flat[flat > 0])) if (flat > 0).any() else 0.0,
+    }
+    if lines is not None:
+        slots = [[len(ln) // 6 - 1 for ln in ch] for ch in lines[-1]]
+        out["mean_slots_per_line"] = float(np.mean(slots))
+    return out
+
+
+def plot_changed(h: dict, path, title: str) -> None:
+    """Histogram (all frames) and per-frame median / p90 / max of changed instructions."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
+    ax[0].bar(range(len(h["hist"])), h["hist"], color="#4477aa")
+    ax[0].set_xticks(range(len(h["hist"])), h["bins"], rotation=30)
+    ax[0].set_xlabel("changed instructions (slots) on a scanline, one colour")
+    ax[0].set_ylabel("scanlines x colours x frames")
+    ax[0].set_yscale("log")
+    ax[0].set_title("histogram over every frame")
+    fr = h["frames"]
+    ax[1].plot(fr, h["max"], label="max", color="#cc6677")
+    ax[1].plot(fr, h["p90"], label="90th percentile", color="#ddaa33")
+    ax[1].plot(fr, h["median"], label="median", color="#4477aa")
+    if "mean_slots_per_line" in h:
+        ax[1].axhline(h["mean_slots_per_line"], ls="--", color="grey",
+                      label=f"mean slots per line ({h['mean_slots_per_line']:.0f})")
+    ax[1].set_xlabel("frame")
+    ax[1].set_ylabel("changed instructions per scanline")
+    ax[1].set_ylim(bottom=0)
+    ax[1].legend(fontsize=8)
+    ax[1].set_title("per frame")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+# ---- the Load Monitor loop, before and after (docs/yproc.md section 10) -----------------
+
+LOD_RUNS = (("open", ("--no-degrade",), "open loop: full quality, no look-ahead"),
+            ("ahead", (), "look-ahead degradation inside each line (yproc's default)"),
+            ("loop", ("--lod-loop",), "Load Monitor loop: per-line level from the previous frame"))
+
+
+def lod_compare(anim_path, out: Path, extra=()) -> dict:
+    """`yproc anim` three times (LOD_RUNS): per frame the lines the Load Monitor (yproc's
+    model of it, equal to the RTL's: test_fig727_lod.py) reports late, the mean level of
+    detail, and for the loop the level of every line. Writes lod.json and lod.png."""
+    yproc = build_yproc()
+    res = {}
+    for name, flags, _ in LOD_RUNS:
+        d = out / f"lod_{name}"
+        t0 = time.time()
+        r = subprocess.run([str(yproc), "anim", str(anim_path), "-o", str(d), *flags, *extra],
+                           capture_output=True, text=True)
+        if r.returncode:
+            raise RuntimeError(f"yproc anim {' '.join(flags)} failed:\n{r.stderr}")
+        res[name] = lod_run_stats(d)
+        print(f"  {name}: overflowing lines per frame {res[name]['overflow_lines']} "
+              f"({time.time() - t0:.0f} s)", flush=True)
+    (out / "lod.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if kk != "levels"}
+                                              for k, v in res.items()}, indent=1) + "\n")
+    plot_lod(res, out / "lod.png", Path(anim_path).name)
+    return res
+
+
+def lod_run_stats(d: Path) -> dict:
+    """Per frame of one `yproc anim` run (its anim_stats.json): late lines, mean level,
+    the busiest line's count, every line's level; the capacity and the scan time."""
+    st = json.loads((Path(d) / "anim_stats.json").read_text())
+    fr = st["frame"]
+    return {"overflow_lines": [f["overflow_lines"] for f in fr],
+            "mean_level": [f["mean_level"] for f in fr],
+            "max_issued": [max(f["issued"]) for f in fr],
+            "levels": [f["levels"] for f in fr],
+            "capacity": st["capacity"], "mean_scan_ms": st["mean_incremental_scan_ms"]}
+
+
+def plot_lod(res: dict, path, title: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
+    col = {"open": "#cc6677", "ahead": "#ddaa33", "loop": "#4477aa"}
+    for name, _, label in LOD_RUNS:
+        r = res[name]
+        ax[0].plot(r["overflow_lines"], label=label, color=col[name], marker=".")
+        if name != "ahead":     # the look-ahead lowers patterns inside a line, not line levels
+            ax[1].plot(r["mean_level"], label=label, color=col[name], marker=".")
+    ax[0].set_xlabel("frame")
+    ax[0].set_ylabel("late (overflowing) lines")
+    ax[0].set_title("overflowing lines per frame")
+    ax[0].legend(fontsize=7)
+    ax[1].set_xlabel("frame")
+    ax[1].set_ylabel("mean level of detail (5 = full)")
+    ax[1].set_title("quality per frame")
+    ax[1].set_ylim(0, 5.3)
+    lv = np.array(res["loop"]["levels"]).T
+    im = ax[2].imshow(lv, aspect="auto", cmap="viridis", vmin=0, vmax=5, interpolation="nearest")
+    ax[2].set_xlabel("frame")
+    ax[2].set_ylabel("scanline")
+    ax[2].set_title("the loop's level per line")
+    fig.colorbar(im, ax=ax[2], fraction=0.05)
+    fig.suptitle(f"{title}: capacity {res['loop']['capacity']} slots per line and colour", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def configure(ap) -> None:
     """The arguments of `diffengine anim` (make anim)."""
     ap.epilog = COMMAND_HELP
@@ -123,12 +278,27 @@ def configure(ap) -> None:
     ap.add_argument("--model", choices=("fast", "numpy"), default="fast",
                     help="golden model of the changed lines: fast = the C functional model "
                          "(default), numpy = diffengine.model.functional")
+    ap.add_argument("--lod-compare", action="store_true",
+                    help="instead: the animation three times (open loop, look-ahead degradation, "
+                         "Load Monitor loop): overflowing lines and quality per frame -> OUT/lod.png, "
+                         "lod.json (docs/yproc.md section 10)")
+    ap.add_argument("--mode", choices=("640x480", "640x485", "1280x1024"),
+                    help="with --lod-compare: the video mode (raster and slots per line) for yproc")
     ap.set_defaults(func=command)
 
 
 def command(a) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.lod_compare:
+        print(f"anim: {a.anim} three times (open loop, look-ahead, Load Monitor loop)", flush=True)
+        try:
+            lod_compare(a.anim, out, ("--mode", a.mode) if a.mode else ())
+        except RuntimeError as e:
+            print(f"anim: error: {e}", file=sys.stderr)
+            return 1
+        print(f"wrote {out / 'lod.png'}, {out / 'lod.json'}")
+        return 0
     yproc = build_yproc()
     t0 = time.time()
     print(f"anim: yproc anim {a.anim} (each frame also re-rendered in full for the check)", flush=True)
@@ -179,6 +349,15 @@ def command(a) -> int:
         gif = f", {out / 'anim.gif'}"
     except ImportError:
         gif = ""
+    h = changed_histogram(st, seq)
+    if h:
+        (out / "changed.json").write_text(json.dumps(h, indent=1) + "\n")
+        plot_changed(h, out / "changed.png", f"{Path(a.anim).name}: instructions changed between "
+                     "successive frames (LCS of each line's commands)")
+        print(f"  changed instructions per scanline (one colour, frames 1..{len(seq) - 1}): median "
+              f"{h['median_all']:.0f} over all lines, {h['median_changed_lines']:.0f} over the changed "
+              f"ones, max {max(h['max'])}; slots per line {h.get('mean_slots_per_line', 0):.0f} on average "
+              f"({out / 'changed.png'})")
     bad = st["frames_differing_from_full"]
     print(f"frames whose streams differ from yproc's full re-render: {bad}; last frame, "
           f"line-by-line update vs from-scratch render: {'identical' if pixel_ok else 'DIFFERENT'}")

@@ -24,6 +24,13 @@ typedef struct yp_options {
     int aa;              /* 1: exact unweighted area sampling, 0: point sampling */
     yp_shading shading;  /* best colour function (degradation goes down from it) */
     double tol;          /* fit tolerance of each quadratic term, pixel units */
+    /* level of detail per line (yp_lod.c, docs/yproc.md section 10): NULL = every line
+     * at the options above; else line_lod[y] in 0..YP_LOD_MAX caps line y's shading,
+     * anti-aliasing, tolerance and texture (yp_lod_line_options) */
+    const unsigned char *line_lod;
+    int no_degrade;      /* 1: no look-ahead degradation inside a line: a line over the
+                          * capacity is emitted as is and overflows (the controller drops
+                          * it); the Load Monitor loop (yp_lod_update) adapts instead */
 } yp_options;
 void yp_options_default(yp_options *o);            /* 640x480 capacity, aa, phong, tol 1 */
 /* slots per line of a video mode "640x480" | "640x485" | "1280x1024"
@@ -39,6 +46,24 @@ hsr_status yp_shader_new(const hsr_scene *sc, yp_shading mode, yp_shader **out,
 void yp_shader_free(yp_shader *s);
 /* Recompute what depends on the vertices / lights after the scene changed. */
 hsr_status yp_shader_update(yp_shader *s, const hsr_scene *sc);
+
+/* Point light (docs/yproc.md section 11): light l of the scene (its colour) placed at
+ * world position pos instead of being directional; falloff R > 0 scales it by
+ * 1 / (1 + (d/R)^2) at distance d (0: no falloff).  Kept across yp_shader_update. */
+hsr_status yp_shader_set_point_light(yp_shader *s, int l, const double pos[3], double falloff);
+
+/* Procedural texture of a material (docs/yproc.md section 11): a periodic quadratic
+ * B-spline with an n x n grid of pseudo-random coefficients in [0, 1] (seed), knots every
+ * `scale` world units along the two world axes the face is least inclined to; it adds
+ * amp * t(u, v) * rgb to the material's colour as its own accumulated term (Eval3 +
+ * SetddI knots), which does not depend on the lights.  Along a scanline of a plane seen
+ * square-on, t is exactly a C1 piecewise quadratic: what the array evaluates.  amp = 0
+ * removes the texture.  Fails (HSR_EPARSE, message in err) if the material could then
+ * exceed intensity 1 (the no-wrap rule of yp_shader_new). */
+typedef struct yp_texture { double scale, amp, rgb[3]; unsigned seed; int n; } yp_texture;
+hsr_status yp_shader_set_texture(yp_shader *s, int material, const yp_texture *t, char *err, size_t errlen);
+/* texture value t(u, v) in [0, 1] at world point P of face fi (-1 if untextured) */
+double yp_texture_at(const yp_shader *s, int fi, const double P[3]);
 
 typedef struct yp_line_stats {
     int cmds[3], slots[3];   /* per colour, without the end-of-line marker */
@@ -86,5 +111,42 @@ hsr_scene *yp_anim_scene(yp_anim *a);          /* the live scene (frame last app
  * none).  With h == NULL only the scene changes (for a full rebuild). */
 hsr_status yp_anim_apply(yp_anim *a, int f, hsr_ctx *h, yp_shader *sh, int *y0, int *y1);
 int yp_cmdlist_equal(const yp_cmdlist *a, const yp_cmdlist *b);
+/* instruction slots of b not matched, in order, by a (longest common subsequence of
+ * the commands): the instructions a frame delta really changes on a line */
+int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b);
+
+/* ---- level of detail from the Load Monitor (yp_lod.c, docs/yproc.md section 10) ---- */
+#define YP_LOD_MAX 5
+/* the options of line level lev (0..YP_LOD_MAX; YP_LOD_MAX = the base options):
+ * 5 base; 4 tolerance x4; 3 also point sampled (no anti-aliasing); 2 also Eval2
+ * colour functions; 1 tolerance x16 and no texture term; 0 tolerance x64.  Each step
+ * costs fewer slots on the shipped scenes (docs/yproc.md section 10; Eval1 pieces of a
+ * Phong-shaded face cost more than Eval2, so "flat" is not a level) */
+void yp_lod_line_options(const yp_options *base, int lev, int *maxlev, int *aa, double *tol, int *texture);
+/* What the Load Monitor (rtl/ctrl/de_load_monitor.sv) records for the n lines of one
+ * colour's frame, line l holding slots[l] instructions (its marker aside), in windows
+ * of capacity + 1 slots (HTotal - 1): a line is on time if its instructions and its
+ * marker fit in what the window has left after discarding the tail of a late line
+ * before it (docs/display-controller.md section 2.4: one word per slot); issued[l] is
+ * then slots[l], else the rest of the window, and late[l] = 1 (checked against the
+ * Verilated controller, sw/tests/test_fig727_lod.py). */
+void yp_lod_monitor(const int *slots, int n, int capacity, int *issued, int *late);
+typedef struct yp_lod yp_lod;
+hsr_status yp_lod_new(int height, int capacity, yp_lod **out);
+void yp_lod_free(yp_lod *l);
+const unsigned char *yp_lod_levels(const yp_lod *l);     /* [height], for yp_options.line_lod */
+/* One step of the loop: the previous frame's per-line records (issued, late; the Load
+ * Monitor's LINE[l]; for three colours the largest count and any late) -> the next
+ * frame's levels (docs/yproc.md section 10).  A line raised last frame and late now
+ * goes back and bars that level; a line late on its own (its window full) drops two
+ * levels and bars the level; one late because a late line above shortened its window,
+ * or above the high-water mark (80 % of the capacity), drops one.  A bar lasts 4
+ * frames, doubling at each late retry, and lifts early when the line's load falls by
+ * 30 %.  A line is raised one level when the next level's predicted load stays under
+ * 70 %: its load times its own cost ratio (measured when it changed level, bounded from
+ * below by late tries; forgotten when its load moves by 30 %) or the ratio learned over
+ * all lines, and the same for its two neighbours.  Returns the lines whose level
+ * changed. */
+int yp_lod_update(yp_lod *l, const int *issued, const int *late);
 
 #endif

@@ -21,6 +21,7 @@ struct yp_anim {
     int frames;
     double *cur_off;                   /* per obj: current translation */
     int *vobj;                         /* per vertex: obj index or -1 */
+    yp_animx *x;                       /* point lights, wander, textures (yp_tex.c) */
 };
 
 int yp_anim_frames(const yp_anim *a) { return a ? a->frames : 0; }
@@ -30,7 +31,8 @@ void yp_anim_free(yp_anim *a)
 {
     if (!a) return;
     hsr_scene_free(a->sc);
-    free(a->base_v); free(a->base_op); free(a->act); free(a->cur_off); free(a->vobj); free(a);
+    free(a->base_v); free(a->base_op); free(a->act); free(a->cur_off); free(a->vobj);
+    yp_animx_free(a->x); free(a);
 }
 
 static double ramp(const action *c, int f)
@@ -106,7 +108,12 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
             action *p = realloc(a->act, sizeof(action) * (size_t)(a->nact + 1));
             if (!p) { st = HSR_ENOMEM; goto fail; }
             a->act = p; a->act[a->nact++] = c;
-        } else AFAIL("unknown statement '%s'", tok[0]);
+        } else {
+            char m[512];
+            int r = a->sc ? yp_animx_parse(&a->x, a->sc, tok, nt, m, sizeof m) : 0;
+            if (r < 0) AFAIL("%s", m);
+            if (r == 0) AFAIL("unknown statement '%s'", tok[0]);
+        }
     }
     if (!a->sc) AFAIL("no 'scene FILE'");
     free(f); f = NULL;
@@ -186,6 +193,7 @@ hsr_status yp_anim_apply(yp_anim *a, int fr, hsr_ctx *h, yp_shader *sh, int *y0,
     for (int l = 0; l < sc->nlights; l++)
         for (int k = 0; k < 3; k++) if (sc->lights[l].dir[k] != old_l[l].dir[k]) lights = 1;
     if (sh) st = yp_shader_update(sh, sc);
+    if (sh && st == HSR_OK) lights |= yp_animx_apply(a->x, fr, sh, &st);
     if (h && st == HSR_OK) {
         /* every moved face and changed opacity of the frame in one hsr_change_many:
          * one damage repair for all of them (docs/hsr.md, "Damage repair") */

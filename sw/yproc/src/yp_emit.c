@@ -44,6 +44,7 @@ void yp_cmdlist_free(yp_cmdlist *l)
 
 void yp_options_default(yp_options *o)
 {
+    memset(o, 0, sizeof *o);   /* line_lod NULL, no_degrade 0 */
     o->capacity = 798; o->aa = 1; o->shading = YP_PHONG; o->tol = 1.0;
 }
 
@@ -226,4 +227,40 @@ hsr_status yp_write_cmd(const yp_frame *fr, int colour, const char *path)
         fprintf(f, "Refresh;\n");
     }
     return fclose(f) == 0 ? HSR_OK : HSR_EIO;
+}
+
+static int cmd_eq(const yp_cmd *p, const yp_cmd *q)
+{
+    return p->op == q->op && p->order == q->order && p->x == q->x && p->dx == q->dx
+           && p->v[0] == q->v[0] && p->v[1] == q->v[1] && p->v[2] == q->v[2];
+}
+
+int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b)
+{
+    /* LCS by dynamic programming over the commands after the common head and tail
+     * (a line changes in a few places; the table is small or absent) */
+    int h = 0, na = a->n, nb = b->n;
+    while (h < na && h < nb && cmd_eq(&a->c[h], &b->c[h])) h++;
+    while (na > h && nb > h && cmd_eq(&a->c[na - 1], &b->c[nb - 1])) { na--; nb--; }
+    int m = na - h, n = nb - h, changed = 0;
+    if (m == 0 || n == 0) {
+        for (int j = h; j < nb; j++) changed += yp_cmd_slots(&b->c[j]);
+        return changed;
+    }
+    int *t = calloc((size_t)(m + 1) * (size_t)(n + 1), sizeof(int));
+    if (!t) { for (int j = h; j < nb; j++) changed += yp_cmd_slots(&b->c[j]); return changed; }
+#define T(i, j) t[(size_t)(i) * (size_t)(n + 1) + (size_t)(j)]
+    for (int i = m - 1; i >= 0; i--)
+        for (int j = n - 1; j >= 0; j--)
+            T(i, j) = cmd_eq(&a->c[h + i], &b->c[h + j]) ? T(i + 1, j + 1) + 1
+                      : T(i + 1, j) > T(i, j + 1) ? T(i + 1, j) : T(i, j + 1);
+    /* walk the table: commands of b not on the common subsequence are changed */
+    for (int i = 0, j = 0; j < n;) {
+        if (i < m && cmd_eq(&a->c[h + i], &b->c[h + j])) { i++; j++; }
+        else if (i < m && T(i + 1, j) >= T(i, j + 1)) i++;
+        else { changed += yp_cmd_slots(&b->c[h + j]); j++; }
+    }
+#undef T
+    free(t);
+    return changed;
 }

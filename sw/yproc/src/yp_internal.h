@@ -24,6 +24,12 @@ struct yp_shader {
     double L[HSR_MAX_LIGHTS][3], Lrgb[HSR_MAX_LIGHTS][3];
     double bg[3];        /* pixel units */
     uint16_t *img;       /* background image, 12-bit, [3][H][W], or NULL */
+    /* point lights (yp_shader_set_point_light): position and falloff per light */
+    int Lpt[HSR_MAX_LIGHTS];
+    double Lpos[HSR_MAX_LIGHTS][3], Lfall[HSR_MAX_LIGHTS];
+    yp_texture *tex;     /* per material (amp 0: none), or NULL if no texture at all */
+    float *texc;         /* per material: n x n coefficients (NULL entries: none) */
+    int ntex;            /* materials in tex */
 };
 
 /* background at pixel (x, y), colour c, pixel units */
@@ -36,6 +42,20 @@ static inline double yp_bg(const yp_shader *s, int c, int x, int y)
  * down), pixel units: base = ambient + diffuse (+ specular unless Phong
  * mode), spec[3*l + c] = specular of light l (Phong mode; else 0). */
 void yp_shade_face(const yp_shader *s, int fi, double px, double py, double base[3], double *spec);
+/* yp_tex.c: the texture term of face fi at pixel position (px, py), pixel units;
+ * 0 (and tex = 0) if its material has none */
+int yp_shade_texture(const yp_shader *s, int fi, double px, double py, double tex[3]);
+/* yp_shade.c: the world point of face fi's plane seen through pixel position (px, py) */
+void yp_face_point(const yp_shader *s, int fi, double px, double py, double P[3]);
+
+/* yp_tex.c: the .anim statements of the textured, point-lit animation (Fig. 7.27):
+ * `pointlight L X Y Z [falloff R]`, `wander L SEED FRAMES X0 Y0 Z0 X1 Y1 Z1 from F0 to F1`,
+ * `texture MATERIAL SCALE AMP R G B SEED [N]`.  parse: 1 taken, 0 not ours, -1 error (msg);
+ * apply: sets frame f on the shader, returns 1 if a light moved since the last call. */
+typedef struct yp_animx yp_animx;
+int yp_animx_parse(yp_animx **x, const hsr_scene *sc, char **tok, int nt, char *msg, size_t msglen);
+int yp_animx_apply(yp_animx *x, int f, yp_shader *sh, hsr_status *st);
+void yp_animx_free(yp_animx *x);
 
 /* yp_cover.c: signed-area accumulation of a closed ring set (pixel
  * coordinates relative to the buffer origin) into acc (ny rows of

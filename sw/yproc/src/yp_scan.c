@@ -36,6 +36,7 @@ typedef struct entry {
     int spec_cost;             /* part of cost[3] after Acc_mode */
     int npart;
     yp_cmdlist lv[4], spec;    /* lv[1..3]: Dis + Sets + Eval over the covered pixels */
+    yp_cmdlist tex;            /* texture term (yp_tex.c), emitted after lv[lev]; in cost[] */
 } entry;
 
 typedef struct line_entries { entry **e; int n, cap; } line_entries;
@@ -96,12 +97,21 @@ typedef struct scan {
     line_entries *le;          /* [y1 - y0][3] */
     /* scratch */
     double *fb, *fs, *ft, *cov;  /* per column: base, spec (nl), total; coverage */
+    double *fx;                /* per column: texture term (3 per column) */
     unsigned char *use, *use2;
     double *tmp, *tolv;
     double *covsum;            /* [y1 - y0][W]: coverage of all patterns */
     arena ar;                  /* entries and their lists */
-    yp_cmdlist wl[4], wspec;   /* scratch lists of one entry */
+    yp_cmdlist wl[4], wspec, wtex;   /* scratch lists of one entry */
 } scan;
+
+/* the options of line y: its level of detail (yp_lod.c) or the frame's */
+static void line_opts(const scan *s, int y, int *maxlev, int *aa, double *tol, int *tex)
+{
+    if (s->o->line_lod) { yp_lod_line_options(s->o, s->o->line_lod[y], maxlev, aa, tol, tex); return; }
+    *maxlev = s->o->shading == YP_FLAT ? 1 : s->o->shading == YP_GOURAUD ? 2 : 3;
+    *aa = s->o->aa; *tol = s->o->tol; *tex = 1;
+}
 
 /* Dis over the runs of [a, b) where in[x - off] == 0 */
 static hsr_status push_dis(yp_cmdlist *l, const unsigned char *in, int a, int b, int off)
@@ -124,8 +134,9 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
 {
     const yp_shader *sh = s->sh;
     const hsr_scene *sc = sh->sc;
-    const yp_options *o = s->o;
-    int nl = s->nl, npart = 0;
+    int nl = s->nl, npart = 0, lmax, laa, ltex, any_tex = 0;
+    double ltol;
+    line_opts(s, y, &lmax, &laa, &ltol, &ltex);
     double area = 0;
     unsigned char *full = s->use;   /* indexed by absolute column */
     for (int x = x0; x < x1; x++) {
@@ -144,19 +155,23 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         w[j] = (j == nvis - 1 && op >= 1) ? rem : rem * op;
         rem -= w[j];
     }
-    double base[3], spec[3 * HSR_MAX_LIGHTS];
+    double base[3], spec[3 * HSR_MAX_LIGHTS], tex[3];
     for (int x = x0; x < x1; x++) {
         if (cov[x - x0] <= 0) continue;
-        double *fb = &s->fb[3 * x], *fs = &s->fs[3 * nl * x];
-        for (int c = 0; c < 3; c++) fb[c] = 0;
+        double *fb = &s->fb[3 * x], *fs = &s->fs[3 * nl * x], *fx = &s->fx[3 * x];
+        for (int c = 0; c < 3; c++) fb[c] = fx[c] = 0;
         for (int i = 0; i < 3 * nl; i++) fs[i] = 0;
         for (int j = 0; j < nvis; j++) {
             yp_shade_face(sh, par[j], x + 0.5, y + 0.5, base, spec);
             for (int c = 0; c < 3; c++) fb[c] += w[j] * (base[c] - yp_bg(sh, c, x, y));
             for (int i = 0; i < 3 * nl; i++) fs[i] += w[j] * spec[i];
+            if (yp_shade_texture(sh, par[j], x + 0.5, y + 0.5, tex)) {
+                any_tex = 1;
+                for (int c = 0; c < 3; c++) fx[c] += w[j] * tex[c];
+            }
         }
         for (int c = 0; c < 3; c++) {
-            double t = fb[c];
+            double t = fb[c] + fx[c];
             for (int l = 0; l < nl; l++) t += fs[3 * l + c];
             s->ft[3 * x + c] = t;
             s->fr->ideal[((size_t)c * s->H + y) * s->W + x] += cov[x - x0] * t;
@@ -182,9 +197,9 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         }
         L->e[L->n++] = e;
         for (int i = 0; i < 4; i++) s->wl[i].n = s->wl[i].slots = 0;
-        s->wspec.n = s->wspec.slots = 0;
+        s->wspec.n = s->wspec.slots = s->wtex.n = s->wtex.slots = 0;
         e->area = area; e->npart = npart;
-        e->maxlev = o->shading == YP_FLAT ? 1 : o->shading == YP_GOURAUD ? 2 : 3;
+        e->maxlev = lmax;
         /* separate specular terms (level 3): lights whose highlight on the
          * fully covered pixels exceeds the tolerance */
         int sep[HSR_MAX_LIGHTS], nsep = 0;
@@ -192,7 +207,7 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             double mx = 0;
             if (e->maxlev == 3)
                 for (int x = a; x <= cl; x++) if (full[x] && s->fs[3 * nl * x + 3 * l + c] > mx) mx = s->fs[3 * nl * x + 3 * l + c];
-            sep[l] = mx > o->tol;
+            sep[l] = mx > ltol;
             nsep += sep[l];
         }
         double *f = s->tmp;
@@ -202,13 +217,13 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             for (int x = a; x <= cl; x++) {
                 double cvx = cov[x - x0], v = 0;
                 if (cvx > 0) {
-                    v = s->ft[3 * x + c];
+                    v = s->ft[3 * x + c] - s->fx[3 * x + c];   /* the texture is its own term */
                     if (lev == 3 && full[x]) for (int l = 0; l < nl; l++) if (sep[l]) v -= s->fs[3 * nl * x + 3 * l + c];
                     v *= cvx;
                 }
                 f[x - a] = v;
             }
-            double tol = o->tol * (e->maxlev == lev ? 1 : e->maxlev - lev == 1 ? 4 : 16);
+            double tol = ltol * (e->maxlev == lev ? 1 : e->maxlev - lev == 1 ? 4 : 16);
             /* partly covered pixels: a tight tolerance, so the pieces of a
              * pixel shared by several patterns add up to its box average */
             double *tv = s->tolv;
@@ -223,12 +238,25 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             int sa = -1, sb = -1;
             unsigned char *use = s->use2;
             for (int x = a; x <= cl; x++)
-                if (full[x] && s->fs[3 * nl * x + 3 * l + c] > o->tol) { if (sa < 0) sa = x; sb = x; }
+                if (full[x] && s->fs[3 * nl * x + 3 * l + c] > ltol) { if (sa < 0) sa = x; sb = x; }
             for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
             st = push_dis(&s->wspec, use, sa, sb + 1, sa);
-            if (st == HSR_OK && yp_fit(f, use, NULL, sb + 1 - sa, sa, 2, o->tol, 1, &s->wspec) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK && yp_fit(f, use, NULL, sb + 1 - sa, sa, 2, ltol, 1, &s->wspec) < 0) st = HSR_ELIMIT;
         }
         if (st == HSR_OK) st = arena_list(&s->ar, &s->wspec, &e->spec);
+        /* the texture term: cov * texture over the covered pixels, one Eval3 spline whose
+         * knots do not depend on the lights (docs/yproc.md section 11) */
+        if (st == HSR_OK && any_tex && ltex) {
+            double *tv = s->tolv;
+            for (int x = a; x <= cl; x++) {
+                f[x - a] = cov[x - x0] > 0 ? cov[x - x0] * s->fx[3 * x + c] : 0;
+                tv[x - a] = cov[x - x0] < 1 ? fmin(ltol, TOL_PARTIAL) : ltol;
+            }
+            st = push_dis(&s->wtex, cv, a, a + n, a);
+            if (st == HSR_OK && yp_fit(f, cv, tv, n, a, 2, ltol, 0, &s->wtex) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK) st = arena_list(&s->ar, &s->wtex, &e->tex);
+            for (int lev = 1; lev <= e->maxlev; lev++) e->cost[lev] += e->tex.slots;
+        }
         if (st != HSR_OK) return st;
         e->spec_cost = e->spec.slots;
         if (e->maxlev == 3) e->cost[3] += e->spec.slots;
@@ -329,7 +357,7 @@ static hsr_status finish_line(scan *s, int y, int c)
         sum += L->e[i]->cost[L->e[i]->lev];
         nsp += L->e[i]->lev == 3 && L->e[i]->spec_cost;
     }
-    for (int lev = 3; lev >= 2 && sum + (nsp > 0) > s->o->capacity; lev--)
+    for (int lev = 3; lev >= 2 && !s->o->no_degrade && sum + (nsp > 0) > s->o->capacity; lev--)
         for (int i = 0; i < n && sum + (nsp > 0) > s->o->capacity; i++)
             if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) {
                 sum -= ord[i]->cost[lev] - ord[i]->cost[lev - 1];
@@ -344,10 +372,12 @@ static hsr_status finish_line(scan *s, int y, int c)
     yp_cmdlist_free(out);
     hsr_status st = HSR_OK;
     ls->merged[c] = ls->overflow[c] = 0;
-    if (cost <= s->o->capacity) {
+    if (cost <= s->o->capacity || s->o->no_degrade) {
         st = append(out, &bgl);
-        for (int i = 0; i < n && st == HSR_OK; i++)
+        for (int i = 0; i < n && st == HSR_OK; i++) {
             st = append(out, &L->e[i]->lv[L->e[i]->lev]);
+            if (st == HSR_OK) st = append(out, &L->e[i]->tex);
+        }
         if (sp && st == HSR_OK) {
             yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}};
             st = yp_cmdlist_push(out, am);
@@ -359,8 +389,9 @@ static hsr_status finish_line(scan *s, int y, int c)
          * opposite.  Check the line with the array model; if it happens, the
          * line takes the merged form below, whose targets keep clear of both. */
         if (st == HSR_OK && wraps(s, out, y, c)) cost = s->o->capacity + 1;
+        else if (cost > s->o->capacity) ls->overflow[c] = 1;   /* no_degrade: as is, the controller drops it */
     }
-    if (st == HSR_OK && cost > s->o->capacity) {
+    if (st == HSR_OK && cost > s->o->capacity && !ls->overflow[c]) {
         /* Even Eval1 for every pattern does not fit: the last resort
          * before dropping anything is one spline for the whole line
          * through the exact target values, with a tolerance raised until
@@ -424,13 +455,14 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     s.fb = malloc(sizeof(double) * 3 * (size_t)W);
     s.fs = malloc(sizeof(double) * 3 * (size_t)(s.nl + 1) * (size_t)W);
     s.ft = malloc(sizeof(double) * 3 * (size_t)W);
+    s.fx = calloc(3 * (size_t)W, sizeof(double));
     s.tmp = malloc(sizeof(double) * (size_t)W);
     s.tolv = malloc(sizeof(double) * (size_t)W);
     s.covsum = calloc((size_t)(y1 - y0) * (size_t)W, sizeof(double));
     s.use = malloc((size_t)W + 1); s.use2 = malloc(2 * (size_t)W + 2);
     double *acc = NULL;
     size_t acccap = 0;
-    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.tmp || !s.tolv || !s.covsum || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
+    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.fx || !s.tmp || !s.tolv || !s.covsum || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
     for (int y = y0; y < y1; y++)
         for (int c = 0; c < 3; c++)
             for (int x = 0; x < W; x++) fr->ideal[((size_t)c * s.H + y) * W + x] = yp_bg(sh, c, x, y);
@@ -466,7 +498,15 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
             acc = p; acccap = need;
         }
         memset(acc, 0, sizeof(double) * need);
-        if (o->aa) {
+        /* anti-aliasing per line (its level of detail): area coverage if any line of the
+         * group has it, then point samples on the lines that do not */
+        int need_aa = 0, need_pt = 0;
+        for (int y = ry0; y < ry1; y++) {
+            int ml, laa, ltx; double lt;
+            line_opts(&s, y, &ml, &laa, &lt, &ltx);
+            if (laa) need_aa = 1; else need_pt = 1;
+        }
+        if (need_aa) {
             for (int i = g; i < ge && st == HSR_OK; i++) {
                 const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
                 double *xy = NULL; int *len = NULL, nr = 0;
@@ -493,16 +533,20 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
                     row[x] = cv < 0 ? 0 : cv > 1 ? 1 : cv;
                 }
             }
-        } else {
-            for (int yy = ry0 - gy0; yy < ry1 - gy0; yy++)
-                for (int x = 0; x < nx; x++) {
-                    int64_t px = (int64_t)(gx0 + x) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
-                    int64_t py = (int64_t)(gy0 + yy) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
-                    for (int i = g; i < ge; i++) {
-                        const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
-                        if (hsr_domain_contains(d, px, py)) { acc[(size_t)yy * (nx + 2) + x] = 1; break; }
-                    }
+        }
+        for (int yy = ry0 - gy0; need_pt && yy < ry1 - gy0; yy++) {
+            int ml, laa, ltx; double lt;
+            line_opts(&s, gy0 + yy, &ml, &laa, &lt, &ltx);
+            if (laa) continue;
+            memset(&acc[(size_t)yy * (nx + 2)], 0, sizeof(double) * (size_t)(nx + 2));
+            for (int x = 0; x < nx; x++) {
+                int64_t px = (int64_t)(gx0 + x) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
+                int64_t py = (int64_t)(gy0 + yy) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
+                for (int i = g; i < ge; i++) {
+                    const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
+                    if (hsr_domain_contains(d, px, py)) { acc[(size_t)yy * (nx + 2) + x] = 1; break; }
                 }
+            }
         }
         for (int y = ry0; y < ry1 && st == HSR_OK; y++)
             st = row_entry(&s, keys[g].par, keys[g].nvis, y, &acc[(size_t)(y - gy0) * (nx + 2)], gx0, gx1);
@@ -519,7 +563,7 @@ done:
     }
     arena_free(&s.ar);
     for (int i = 0; i < 4; i++) yp_cmdlist_free(&s.wl[i]);
-    yp_cmdlist_free(&s.wspec);
+    yp_cmdlist_free(&s.wspec); yp_cmdlist_free(&s.wtex); free(s.fx);
     free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
     return st;
 }

@@ -1,5 +1,5 @@
 /* yp_shade.c - the shading model of docs/shading.md: corner normals
- * (authored `vn`, smoothing groups, smooth vertex normals), directional lights, Phong illumination (eq. 6.1.a with the
+ * (authored `vn`, smoothing groups, smooth vertex normals), directional and point lights (yp_shader_set_point_light), Phong illumination (eq. 6.1.a with the
  * surface coefficients of Foley 90), two-sided, local viewer; and the
  * flat / Gouraud colour functions.  Values are in pixel units (4095 = 1). */
 #include <math.h>
@@ -9,6 +9,7 @@
 #include "yp_internal.h"
 
 static hsr_status read_ppm(const char *path, const char *where, int W, int H, uint16_t **out, char *err, size_t errlen);
+static void centroid(const hsr_scene *sc, int fi, double *P);
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static int unit3(double *a)
@@ -49,11 +50,19 @@ static void phong(const yp_shader *s, const hsr_material *m, const double *P, co
     for (int c = 0; c < 3; c++) base[c] = s->sc->ambient * m->rgb[c];
     for (int l = 0; l < s->nl; l++) {
         const double *L = s->L[l];
-        double nl = dot3(N, L), d = nl > 0 ? nl : 0, sp = 0;
+        double Lp[3], att = 1;
+        if (s->Lpt[l]) {   /* point light: towards its position, with its falloff */
+            for (int k = 0; k < 3; k++) Lp[k] = s->Lpos[l][k] - P[k];
+            double d2 = dot3(Lp, Lp);
+            if (s->Lfall[l] > 0) att = 1 / (1 + d2 / (s->Lfall[l] * s->Lfall[l]));
+            if (!unit3(Lp)) { Lp[0] = N[0]; Lp[1] = N[1]; Lp[2] = N[2]; }
+            L = Lp;
+        }
+        double nl = dot3(N, L), d = nl > 0 ? att * nl : 0, sp = 0;
         if (m->ks > 0) {
             double R[3] = {2 * nl * N[0] - L[0], 2 * nl * N[1] - L[1], 2 * nl * N[2] - L[2]};
             double er = dot3(E, R);
-            sp = er > 0 ? m->ks * pow(er, m->shininess) : 0;
+            sp = er > 0 ? att * m->ks * pow(er, m->shininess) : 0;
         }
         for (int c = 0; c < 3; c++) {
             base[c] += s->Lrgb[l][c] * m->rgb[c] * d;
@@ -117,6 +126,22 @@ static void centroid(const hsr_scene *sc, int fi, double *P)
     for (int i = 0; i < c; i++) for (int k = 0; k < 3; k++) P[k] += vtx(sc, fi, i)[k] / c;
 }
 
+void yp_face_point(const yp_shader *s, int fi, double px, double py, double P[3])
+{
+    /* ray through the pixel position, intersected with the face's plane */
+    const hsr_scene *sc = s->sc;
+    const hsr_view *vw = &s->vw;
+    double a = (px - vw->W / 2) / vw->f, b = (vw->H / 2 - py) / vw->f, dir[3];
+    for (int k = 0; k < 3; k++) dir[k] = a * vw->u[k] + b * vw->v[k] - vw->w[k];
+    const double *n = &s->fn[3 * fi], *p0 = vtx(sc, fi, 0);
+    double den = dot3(n, dir);
+    if (fabs(den) > 1e-12) {
+        double d0[3] = {p0[0] - sc->eye[0], p0[1] - sc->eye[1], p0[2] - sc->eye[2]};
+        double t = dot3(n, d0) / den;
+        for (int k = 0; k < 3; k++) P[k] = sc->eye[k] + t * dir[k];
+    } else centroid(sc, fi, P);
+}
+
 void yp_shade_face(const yp_shader *s, int fi, double px, double py, double base[3], double *spec)
 {
     const hsr_scene *sc = s->sc;
@@ -129,18 +154,8 @@ void yp_shade_face(const yp_shader *s, int fi, double px, double py, double base
         }
         return;
     }
-    /* ray through the pixel position, intersected with the face's plane */
-    const hsr_view *vw = &s->vw;
-    double a = (px - vw->W / 2) / vw->f, b = (vw->H / 2 - py) / vw->f, dir[3], P[3];
-    for (int k = 0; k < 3; k++) dir[k] = a * vw->u[k] + b * vw->v[k] - vw->w[k];
-    const double *n = &s->fn[3 * fi], *p0 = vtx(sc, fi, 0);
-    double den = dot3(n, dir);
-    if (fabs(den) > 1e-12) {
-        double d0[3] = {p0[0] - sc->eye[0], p0[1] - sc->eye[1], p0[2] - sc->eye[2]};
-        double t = dot3(n, d0) / den;
-        for (int k = 0; k < 3; k++) P[k] = sc->eye[k] + t * dir[k];
-    } else centroid(sc, fi, P);
-    double N[3];
+    double P[3], N[3];
+    yp_face_point(s, fi, px, py, P);
     face_point_normal(s, fi, P, N);
     phong(s, &sc->mat[sc->f[fi].material], P, N, base, spec, 1);
 }
@@ -358,6 +373,6 @@ static hsr_status read_ppm(const char *path, const char *where, int W, int H, ui
 void yp_shader_free(yp_shader *s)
 {
     if (!s) return;
-    free(s->img);
+    free(s->img); free(s->tex); free(s->texc);
     free(s->cn); free(s->ck); free(s->pn); free(s->fn); free(s->flat); free(s->gour); free(s);
 }

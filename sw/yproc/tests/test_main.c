@@ -2,11 +2,14 @@
 #include <string.h>
 #include "t.h"
 
+void suite_yp_tex_lod(void);   /* test_yp_tex_lod.c */
+
 int main(int argc, char **argv)
 {
     for (int i = 1; i < argc; i++)
         if (!strcmp(argv[i], "--quick")) t_quick = 1;
     suite_yp();
     suite_obj_shading();
+    suite_yp_tex_lod();
     return t_report();
 }

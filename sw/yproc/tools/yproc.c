@@ -5,7 +5,7 @@
  *  then a full hsr_rebuild of the resulting MLR, for comparison)
  *   yproc scan SCENE -o OUTDIR [--mode M] [--no-aa] [--shading S] [--frames N]
  *                    [--cmd] [--tol T] [--capacity N] [--expect]
- *   yproc anim ANIMSCENE -o OUTDIR [scan options] [--full]
+ *   yproc anim ANIMSCENE -o OUTDIR [scan options] [--full] [--lod-loop]
  * (scan / anim: docs/yproc.md)
  * Reads the scene (and its OBJ files), applies viewing and perspective,
  * runs the exact incremental HSR and writes the requested outputs.
@@ -27,8 +27,8 @@ static const char USAGE[] =
     "                 [--stats] [--ops FILE] [--rebuild]\n"
     "       yproc scan SCENE -o OUTDIR [--mode 640x480|640x485|1280x1024] [--no-aa]\n"
     "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
-    "                  [--capacity SLOTS] [--expect]\n"
-    "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full]\n"
+    "                  [--capacity SLOTS] [--expect] [--no-degrade] [--lod L]\n"
+    "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full] [--lod-loop]\n"
     "       yproc read SCENE -o FILE.json\n"
     "       yproc serve SCENE --dir DIR\n"
     "\n"
@@ -43,8 +43,12 @@ static const char USAGE[] =
     "      --cmd           also write the commands as text       --tol T         fit tolerance (>= 0.01)\n"
     "      --capacity N    slots per line (>= 4; default: the mode's, Table 7.3)\n"
     "      --expect        also write the expected pixels\n"
+    "      --no-degrade    no look-ahead degradation: a line over the capacity overflows\n"
+    "      --lod L         every line at level of detail L (0..5; 5 = the options; docs/yproc.md 10)\n"
     "anim  an animation (.anim) through the incremental pipeline, frame by frame\n"
     "      --full          re-render every frame in full (the baseline)\n"
+    "      --lod-loop      per-line level of detail from the previous frame's Load Monitor\n"
+    "                      counts (model of rtl/ctrl/de_load_monitor.sv; implies --no-degrade)\n"
     "read  the scene and its OBJ/MTL files as read, as JSON (schema hsr-scene-1, docs/hsr.md):\n"
     "      what the Python reference renderer draws, so every format has one reader\n"
     "serve the scene held for the viewer (docs/viewer.md): one request a line on stdin (pick,\n"

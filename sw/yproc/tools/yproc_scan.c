@@ -25,13 +25,15 @@ typedef struct opts {
     const char *in, *out, *mode;
     yp_options yo;
     int frames, cmd, expect, full, width, height, mode_given;
+    int lod_loop;        /* anim: per-line level of detail from the Load Monitor model */
+    int lod_all;         /* scan: every line at this level of detail (-1: the options) */
 } opts;
 
 static int parse(int argc, char **argv, opts *o)
 {
     memset(o, 0, sizeof *o);
     yp_options_default(&o->yo);
-    o->in = argv[2]; o->mode = "640x480"; o->frames = 1;
+    o->in = argv[2]; o->mode = "640x480"; o->frames = 1; o->lod_all = -1;
     int cap = 0;
     for (int i = 3; i < argc; i++) {
         const char *a = argv[i];
@@ -40,8 +42,10 @@ static int parse(int argc, char **argv, opts *o)
         else if (!strcmp(a, "--cmd")) o->cmd = 1;
         else if (!strcmp(a, "--expect")) o->expect = 1;
         else if (!strcmp(a, "--full")) o->full = 1;
+        else if (!strcmp(a, "--no-degrade")) o->yo.no_degrade = 1;
+        else if (!strcmp(a, "--lod-loop")) { o->lod_loop = 1; o->yo.no_degrade = 1; }
         else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
-                 && strcmp(a, "--tol") && strcmp(a, "--capacity"))
+                 && strcmp(a, "--tol") && strcmp(a, "--capacity") && strcmp(a, "--lod"))
             return yproc_usage_error("unknown option", a);
         else if (!has_value) return yproc_usage_error("missing value after", a);
         else if (!strcmp(a, "-o")) o->out = argv[++i];
@@ -55,6 +59,11 @@ static int parse(int argc, char **argv, opts *o)
         } else if (!strcmp(a, "--frames")) {
             o->frames = atoi(argv[++i]);
             if (o->frames < 1) return yproc_usage_error("--frames takes a count >= 1, not", argv[i]);
+        } else if (!strcmp(a, "--lod")) {
+            char *end;
+            long v = strtol(argv[++i], &end, 10);
+            if (*end || v < 0 || v > YP_LOD_MAX) return yproc_usage_error("--lod takes a level 0..5, not", argv[i]);
+            o->lod_all = (int)v;
         } else if (!strcmp(a, "--tol")) {
             o->yo.tol = atof(argv[++i]);
             if (!(o->yo.tol >= 0.01)) return yproc_usage_error("--tol takes a number >= 0.01, not", argv[i]);
@@ -205,7 +214,12 @@ static int scan_main(opts *o)
     free(shade);
     double t2 = now_ms();
     yp_frame *fr = NULL;
+    unsigned char *lv = NULL;
     st = yp_frame_new(sc->width, sc->height, &fr);
+    if (o->lod_all >= 0 && st == HSR_OK) {
+        if (!(lv = malloc((size_t)sc->height))) st = HSR_ENOMEM;
+        else { memset(lv, o->lod_all, (size_t)sc->height); o->yo.line_lod = lv; }
+    }
     for (int k = 0; k < o->frames && st == HSR_OK; k++) st = yp_scan(sh, h, &o->yo, 0, sc->height, fr);
     double t3 = now_ms();
     int rc = 0;
@@ -229,7 +243,7 @@ static int scan_main(opts *o)
             fprintf(stderr, "yproc: warning: %d line(s) exceed %d slots even as one spline per line (see stats.json)\n",
                     t.lines_overflow, o->yo.capacity);
     }
-    yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); hsr_scene_free(sc);
+    yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); hsr_scene_free(sc); free(lv);
     return rc;
 }
 
@@ -284,6 +298,33 @@ static int copy_lines(yp_cmdlist *dst, const yp_frame *fr)
     return 0;
 }
 
+/* the frame as the Load Monitor records it (yp_lod_monitor, per line: the
+ * largest count of the three colours, late if any is): overflowing lines, the mean
+ * level of detail and, with the loop, the levels of the next frame after the update */
+static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap)
+{
+    int H = fr->height, ovl = 0, *iss = calloc(4 * (size_t)H + 1, sizeof(int));
+    if (!iss) return 1;
+    int *late = iss + H, *ic = iss + 2 * H, *lc = iss + 3 * H;
+    for (int c = 0; c < 3; c++) {
+        for (int y = 0; y < H; y++) ic[y] = fr->st[y].slots[c];
+        yp_lod_monitor(ic, H, cap, ic, lc);
+        for (int y = 0; y < H; y++) { if (ic[y] > iss[y]) iss[y] = ic[y]; late[y] |= lc[y]; }
+    }
+    for (int y = 0; y < H; y++) ovl += late[y];
+    const unsigned char *lv = yp_lod_levels(lod);
+    double mean = YP_LOD_MAX;
+    if (lv) { mean = 0; for (int y = 0; y < H; y++) mean += lv[y]; mean /= H; }
+    fprintf(js, ", \"overflow_lines\": %d, \"mean_level\": %.4f, \"levels\": [", ovl, mean);
+    for (int y = 0; y < H; y++) fprintf(js, "%s%d", y ? ", " : "", lv ? lv[y] : YP_LOD_MAX);
+    fprintf(js, "], \"issued\": [");
+    for (int y = 0; y < H; y++) fprintf(js, "%s%d", y ? ", " : "", iss[y]);
+    fprintf(js, "]");
+    if (lod) yp_lod_update(lod, iss, late);
+    free(iss);
+    return 0;
+}
+
 static int anim_main(opts *o)
 {
     char err[1024] = "", p[4096];
@@ -298,13 +339,20 @@ static int anim_main(opts *o)
     double *shade;
     int rc = 0, F = yp_anim_frames(an), W = sc->width, H = sc->height;
     yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
+    int *chslots = calloc(3 * (size_t)H, sizeof(int));
+    unsigned char *lod_prev = malloc((size_t)H + 1);
     char *changed[3];
     for (int c = 0; c < 3; c++) changed[c] = calloc((size_t)H, 1);
-    if (!prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
+    if (!prev || !chslots || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
+    memset(lod_prev, YP_LOD_MAX, (size_t)H);
+    yp_lod *lod = NULL;
     if ((st = yp_anim_apply(an, 0, NULL, NULL, NULL, NULL)) != HSR_OK
-        || (st = yp_shader_new(sc, o->yo.shading, &sh, err, sizeof err)) != HSR_OK) {
+        || (st = yp_shader_new(sc, o->yo.shading, &sh, err, sizeof err)) != HSR_OK
+        || (st = yp_anim_apply(an, 0, NULL, sh, NULL, NULL)) != HSR_OK     /* point lights, textures */
+        || (o->lod_loop && (st = yp_lod_new(H, o->yo.capacity, &lod)) != HSR_OK)) {
         fprintf(stderr, "%s\n", err[0] ? err : hsr_status_str(st)); rc = 1; goto out;
     }
+    if (lod) o->yo.line_lod = yp_lod_levels(lod);
     double t0 = now_ms();
     if ((st = hsr_scene_build(sc, &h, &shade)) != HSR_OK) { fprintf(stderr, "%s: %s\n", o->in, hsr_status_str(st)); rc = 1; goto out; }
     free(shade);
@@ -317,7 +365,10 @@ static int anim_main(opts *o)
     FILE *js = fopen(p, "w");
     if (!js) { rc = 1; goto out; }
     fprintf(js, "{\"format\": \"yproc-anim-1\", \"anim\": \"%s\", \"frames\": %d, \"width\": %d, \"height\": %d, "
-                "\"capacity\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f}", o->in, F, W, H, o->yo.capacity, t1 - t0);
+                "\"capacity\": %d, \"lod_loop\": %d, \"no_degrade\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f",
+            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->yo.no_degrade, t1 - t0);
+    if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; fclose(js); goto out; }
+    fprintf(js, "}");
     double sum_inc = 0, sum_full = 0, sum_inc_scan = 0, sum_full_scan = 0;
     long sum_changed = 0;
     int mismatches = 0, degraded_lines = 0;
@@ -325,6 +376,10 @@ static int anim_main(opts *o)
         int y0, y1;
         double a0 = now_ms();
         st = yp_anim_apply(an, f, h, sh, &y0, &y1);
+        /* lines whose level of detail changed are re-scanned too */
+        for (int y = 0; lod && y < H; y++)
+            if (lod_prev[y] != yp_lod_levels(lod)[y]) { if (y0 == y1) { y0 = y; y1 = y + 1; } if (y < y0) y0 = y; if (y + 1 > y1) y1 = y + 1; }
+        if (lod) memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
         double am = now_ms();
         if (st == HSR_OK) st = yp_scan(sh, h, &o->yo, y0, y1, fr);
         double a1 = now_ms();
@@ -334,6 +389,8 @@ static int anim_main(opts *o)
             for (int y = 0; y < H; y++) {
                 changed[c][y] = y >= y0 && y < y1 && !yp_cmdlist_equal(&fr->line[c * H + y], &prev[c * H + y]);
                 nch[c] += changed[c][y];
+                /* instructions of the line that the delta really changes (LCS of the commands) */
+                chslots[c * H + y] = changed[c][y] ? yp_cmdlist_changed_slots(&prev[c * H + y], &fr->line[c * H + y]) : 0;
             }
         snprintf(p, sizeof p, "%s/frame%03d.delta", o->out, f);
         if (write_delta(p, f, fr, changed) || copy_lines(prev, fr)) { rc = 1; break; }
@@ -363,8 +420,14 @@ static int anim_main(opts *o)
         fprintf(js, ",\n  {\"frame\": %d, \"rescanned_lines\": [%d, %d], \"changed_lines\": [%d, %d, %d], "
                     "\"incremental_ms\": %.3f, \"incremental_hsr_ms\": %.3f, \"incremental_scan_ms\": %.3f, "
                     "\"delta_write_ms\": %.3f, \"full_ms\": %.3f, \"full_hsr_ms\": %.3f, \"full_scan_ms\": %.3f, "
-                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d}",
+                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d",
                 f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am, a2 - a1, b1 - b0, bm - b0, b1 - bm, diff, deg);
+        fprintf(js, ", \"changed_slots\": [");
+        for (int c = 0; c < 3; c++)
+            for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chslots[c * H + y], y == H - 1 ? "]" : "");
+        fprintf(js, "]");
+        if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; break; }
+        fprintf(js, "}");
         printf("frame %3d: lines %3d..%3d rescanned, changed r/g/b %d/%d/%d; incremental %.1f ms (hsr %.1f + scan %.1f), "
                "full %.1f ms (hsr %.1f + scan %.1f)%s\n", f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am,
                b1 - b0, bm - b0, b1 - bm, diff ? " MISMATCH with full re-render" : "");
@@ -383,7 +446,7 @@ static int anim_main(opts *o)
     }
 out:
     if (prev) for (int i = 0; i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
-    free(prev);
+    free(prev); free(chslots); free(lod_prev); yp_lod_free(lod);
     for (int c = 0; c < 3; c++) free(changed[c]);
     yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); yp_anim_free(an);
     return rc;

@@ -1,0 +1,265 @@
+"""The host tool fpga/ulx3s/de32_load.py against a simulated board: the pure-Python loader
+model fpga/ulx3s/loader_model.py (no cocotb) behind a pty, with injected errors.
+
+  * the model's protocol: replies, checksum / field errors, skipped garbage, counters;
+  * a scene (three .de32 files) loaded in one command through a pty with a corrupted
+    byte inside a 'W' (NACKed 'E', re-sent) and a swallowed reply (timeout, re-sent):
+    every frame-store word, the descriptors and the output window equal the files;
+  * a dropped link half-way: exit status 2, the state file names the last acknowledged
+    packet, and --resume on a new link sends only the packets after it and completes;
+  * a scene directory of .de48 streams plus an animation directory (frame000/ and a
+    YPD1 delta), --window / --round: every frame stored one after the other per colour;
+  * bad inputs name file and byte / slot / line; --help; the progress line.
+SEED=<n> replays the random words.
+"""
+from __future__ import annotations
+
+import json
+import os
+import pty
+import random
+import struct
+import sys
+from pathlib import Path
+
+import pytest
+
+HERE = Path(__file__).resolve().parent
+ULX = HERE.parent.parent / "fpga" / "ulx3s"
+sys.path.insert(0, str(ULX))
+sys.path.insert(0, str(HERE.parent.parent / "sw"))
+
+import de32_load as dl  # noqa: E402
+from loader_model import Device, Faults, LoaderModel  # noqa: E402
+
+FAST = ["--abandon", "0.1"]          # the model abandons a partial command after 0.05 s
+
+
+def seed() -> int:
+    s = int(os.environ.get("SEED", random.randrange(1 << 30)))
+    print(f"SEED={s}")
+    return s
+
+
+def board(model: LoaderModel, faults: Faults | None = None):
+    """A pty: the device serves the master end; the host opens the slave's path."""
+    master, slave = pty.openpty()
+    path = os.ttyname(slave)
+    dev = Device(master, model, faults, timeout=0.05)
+    return dev, path, slave
+
+
+def write_de32(path: Path, words, window=2, comp=False) -> None:
+    path.write_bytes(b"DE32" + struct.pack(">HBB", 1, window, int(comp))
+                     + b"".join(struct.pack(">I", w) for w in words))
+
+
+def scene(tmp: Path, rng: random.Random, n=(700, 513, 260)) -> tuple[list[str], list]:
+    files, words = [], []
+    for c, k in zip("rgb", n):
+        w = [rng.randrange(1 << 32) for _ in range(k)]
+        write_de32(tmp / f"{c}.de32", w, window=c == "g" and 3 or 1, comp=c == "r")
+        files.append(str(tmp / f"{c}.de32"))
+        words.append(w)
+    return files, words
+
+
+# ---------------------------------------------------------------------- the model
+def test_model_protocol():
+    m = LoaderModel(fs_depth=64)
+    assert m.feed(dl.cmd_w(1, 3, [0x11223344, 0x55667788])) == b"K"
+    assert m.fs[1][3:5] == [0x11223344, 0x55667788]
+    bad = bytearray(dl.cmd_w(1, 3, [0xAAAAAAAA]))
+    bad[-1] ^= 1
+    assert m.feed(bytes(bad)) == b"E" and m.cerr == 1
+    assert m.fs[1][3] == 0xAAAAAAAA, "words are written as they arrive, like the RTL"
+    assert m.feed(dl.cmd_w(3, 0, [1])) == b"E"             # colour out of range
+    assert m.feed(dl.cmd_w(0, 63, [1, 2])) == b"E"         # runs off the frame store
+    assert m.feed(b"\x00\x01") == b"" and m.kerr == 4      # 2 fields + 2 garbage bytes
+    assert m.feed(dl.cmd_p(2, 5, 9, 4, True)) == b"K" and m.desc[2] == (5, 9, 4, True)
+    assert m.feed(dl.cmd_p(2, 5, 9, 5, True)) == b"E"      # window > 4
+    assert m.feed(dl.cmd_o(3, False)) == b"K" and m.out8 == (3, 0)
+    m.regs[0x3000] = 0xDC310004
+    assert m.feed(dl.with_chk(b"R\x30\x00")) == b"R\xdc\x31\x00\x04"
+    s = m.feed(dl.with_chk(b"S"))
+    assert len(s) == 16 and s[:4] == b"S\x01\x01\x06"
+    assert struct.unpack(">HHH", s[4:10]) == (0, 1, 5) and s[13] == 3
+    assert m.feed(b"W\x00") == b"" and m.busy() and m.idle() == b"T" and not m.busy()
+
+
+# ---------------------------------------------------------------------- scene over a pty
+def test_scene_with_errors(tmp_path):
+    rng = random.Random(seed())
+    files, words = scene(tmp_path, rng)
+    m = LoaderModel(fs_depth=2048)
+    # 'S' is 2 bytes; the first 'W' (64 words) is 263: corrupt a data byte of the second
+    # 'W', swallow the reply to the fourth packet.
+    dev, path, slave = board(m, Faults(corrupt_rx={2 + 263 + 100}, drop_reply={4}))
+    st = tmp_path / "state.json"
+    rc = dl.main([path, *files, "--words", "64", "--state", str(st), "--shift", "2",
+                  *FAST])
+    dev.stop()
+    os.close(slave)
+    assert rc == 0
+    assert m.cerr == 1, "the corrupted byte must fail the checksum"
+    for c in range(3):
+        assert m.fs[c][:len(words[c])] == words[c], f"colour {c} differs"
+    assert m.desc == [(0, 700, 1, True), (0, 513, 3, False), (0, 260, 1, False)]
+    assert m.out8 == (2, 1)
+    n_pkts = sum(-(-len(w) // 64) for w in words) + 4
+    s = json.loads(st.read_text())
+    assert s["acked"] == s["packets"] == n_pkts
+    # Re-sends: the NACKed packet and the one whose reply was lost (both idempotent).
+    assert dev.replies.count(b"E") == 1
+    assert m.writes == sum(len(w) for w in words) + 64 + 64
+
+
+def test_dropped_link_and_resume(tmp_path, capsys):
+    rng = random.Random(seed())
+    files, words = scene(tmp_path, rng)
+    m = LoaderModel(fs_depth=2048)
+    st = tmp_path / "state.json"
+    args = [*files, "--words", "32", "--state", str(st), *FAST]
+    dev, path, slave = board(m, Faults(drop_link_after=5000))
+    rc = dl.main([path, *args])
+    dev.stop()
+    os.close(slave)
+    assert rc == 2 and dev.dropped
+    assert "--resume" in capsys.readouterr().err
+    acked = json.loads(st.read_text())["acked"]
+    sizes = [min(32, len(w) - k) for w in words for k in range(0, len(w), 32)]
+    sent = 2                                    # the 'S' of the size check
+    for k in range(acked):
+        sent += 7 + 4 * sizes[k]
+    assert 0 < acked and sent <= 5000 < sent + 7 + 4 * sizes[acked], (acked, sent)
+    # Resume on a new link: the board kept its memory; only packets >= acked are sent.
+    before = m.writes
+    dev2, path2, slave2 = board(m)
+    assert dl.main([path2, *args, "--resume"]) == 0
+    dev2.stop()
+    os.close(slave2)
+    total = sum(len(w) for w in words)
+    assert m.writes - before == total - sum(sizes[:acked])
+    for c in range(3):
+        assert m.fs[c][:len(words[c])] == words[c]
+    assert json.loads(st.read_text())["acked"] == json.loads(st.read_text())["packets"]
+    # A finished load resumes to nothing; another load's state is refused with its file.
+    dev3, path3, slave3 = board(m)
+    assert dl.main([path3, *args, "--resume"]) == 0
+    assert dl.main([path3, *args, "--resume", "--base", "4"]) == 1
+    dev3.stop()
+    os.close(slave3)
+    assert f"{st}:1: written for another load" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------- .de48 + animation
+def _line(rng, w):
+    from diffengine import isa
+    cmds = []
+    for _ in range(rng.randrange(1, 4)):
+        x = rng.randrange(0, 600)
+        v = [rng.randrange(-1000, 1000) << (4 + w) for _ in range(2)]
+        cmds.append(isa.Command("EVAL", x, rng.randrange(1, 40), tuple(v)))
+    cmds.append(isa.Command("REFRESH"))
+    return b"".join((i << 36 | d).to_bytes(6, "big") for i, d in isa.serialise(cmds))
+
+
+def test_scene_dir_and_anim(tmp_path):
+    from diffengine.formats import binfmt
+    rng = random.Random(seed())
+    w, h = 2, 5
+    f0 = tmp_path / "anim" / "frame000"
+    f0.mkdir(parents=True)
+    lines = [[_line(rng, w) for _ in range(h)] for _ in range(3)]
+    for c, ch in enumerate("rgb"):
+        (f0 / f"{ch}.de48").write_bytes(b"DE48" + struct.pack(">HH", 1, 0) + b"".join(lines[c]))
+    # Frame 1: line 2 of green and line 4 of blue change (YPD1, sw/diffengine/pipeline/anim.py).
+    new = {1: {2: _line(rng, w)}, 2: {4: _line(rng, w)}}
+    d = bytearray(b"YPD1" + struct.pack(">4H", 1, 1, 640, h))
+    for c in range(3):
+        ch = new.get(c, {})
+        d += struct.pack(">I", len(ch))
+        for y, words in ch.items():
+            d += struct.pack(">HI", y, len(words) // 6) + words
+    (tmp_path / "anim" / "frame001.delta").write_bytes(bytes(d))
+
+    m = LoaderModel(fs_depth=4096)
+    dev, path, slave = board(m)
+    rc = dl.main([path, str(f0), "--anim", str(tmp_path / "anim"), "--window", str(w),
+                  "--state", str(tmp_path / "s.json"), "--show", "2", *FAST])
+    dev.stop()
+    os.close(slave)
+    assert rc == 0
+    frames = [lines, lines, [lines[0], [new[1].get(y, lines[1][y]) for y in range(h)],
+                             [new[2].get(y, lines[2][y]) for y in range(h)]]]
+    for c in range(3):
+        base = 0
+        for f, fr in enumerate(frames):
+            slots = binfmt.decode_de48(b"DE48\0\1\0\0" + b"".join(fr[c]))
+            cmds = binfmt.deserialise(slots)
+            want = binfmt.framestore_encode(cmds, w)
+            assert m.fs[c][base:base + len(want)] == want, f"frame {f} colour {c}"
+            if f == 2:
+                assert m.desc[c] == (base, len(want), w, False)
+            base += len(want)
+
+
+# ---------------------------------------------------------------------- errors, help
+def test_bad_inputs_name_file(tmp_path, capsys):
+    rng = random.Random(seed())
+    files, _ = scene(tmp_path, rng, n=(4, 4, 4))
+    Path(files[1]).write_bytes(Path(files[1]).read_bytes()[:-2])
+    assert dl.main(["/nonexistent", *files]) == 1
+    assert f"{files[1]}:byte 22: truncated" in capsys.readouterr().err
+    # A .de48 value below the window's grid: an error naming file and slot, unless --round.
+    from diffengine import isa
+    sl = isa.serialise([isa.Command("EVAL", 1, 2, (3, 1 << 20)), isa.Command("REFRESH")])
+    for c in "rgb":
+        (tmp_path / f"{c}.de48").write_bytes(
+            b"DE48\0\1\0\0" + b"".join((i << 36 | d).to_bytes(6, "big") for i, d in sl))
+    de48 = [str(tmp_path / f"{c}.de48") for c in "rgb"]
+    assert dl.main(["/nonexistent", *de48, "--window", "1"]) == 1
+    err = capsys.readouterr().err
+    assert f"{de48[0]}:slot 2:" in err and "--round" in err, err
+    img = dl.read_image(de48[0], 1, True)
+    assert len(img[0]) == len(sl)
+    # A broken state file: its line.
+    st = tmp_path / "st.json"
+    st.write_text('{"plan": "x",\n "acked": }\n')
+    write_de32(Path(files[1]), [1, 2, 3])
+    m = LoaderModel(fs_depth=64)
+    dev, path, slave = board(m)
+    assert dl.main([path, *files, "--state", str(st), "--resume", *FAST]) == 1
+    dev.stop()
+    os.close(slave)
+    assert f"{st}:2:" in capsys.readouterr().err
+
+
+def test_help_and_progress(capsys):
+    with pytest.raises(SystemExit) as e:
+        dl.main(["--help"])
+    assert e.value.code == 0
+    out = capsys.readouterr().out
+    assert "--resume" in out and "--anim" in out
+
+    class Tty:
+        def __init__(self):
+            self.text = ""
+
+        def isatty(self):
+            return True
+
+        def write(self, s):
+            self.text += s
+
+        def flush(self):
+            pass
+
+    t = Tty()
+    p = dl.Progress(300_000, t)
+    p.update(150_000)
+    p.finish()
+    assert t.text.startswith("\r[" + "#" * 15) and t.text.endswith("\n"), t.text
+    line = p.line()
+    assert "150.0/300.0 kB" in line and "kB/s" in line and "ETA" in line, line
+    assert line.startswith("[" + "#" * 15 + " " * 15 + "]"), line
