@@ -21,14 +21,8 @@ module de_access_ctrl #(
   parameter int unsigned NumBuf       = 4,
   parameter int unsigned ArrayLatency = 3,
   parameter int unsigned SkipW        = 8,
-  parameter int unsigned TestHActive  = 16,
-  parameter int unsigned TestHFp      = 2,
-  parameter int unsigned TestHSync    = 3,
-  parameter int unsigned TestHBp      = 3,
-  parameter int unsigned TestVActive  = 6,
-  parameter int unsigned TestVFp      = 1,
-  parameter int unsigned TestVSync    = 2,
-  parameter int unsigned TestVBp      = 2,
+  // Mode 3's geometry (de_video_timing).
+  parameter de_pkg::video_mode_t TestMode = de_pkg::VideoTestDefault,
   localparam int unsigned IdxW        = (NumBuf > 1) ? $clog2(NumBuf) : 1
 ) (
   input  logic                         clk_i,
@@ -80,11 +74,7 @@ module de_access_ctrl #(
   logic [11:0] h, v, h_total, v_total, v_active, next_line;
   logic        t_hsync, t_vsync, t_de, line_start, next_active, hpol, vpol;
 
-  de_video_timing #(
-    .TestHActive(TestHActive), .TestHFp(TestHFp), .TestHSync(TestHSync),
-    .TestHBp(TestHBp), .TestVActive(TestVActive), .TestVFp(TestVFp),
-    .TestVSync(TestVSync), .TestVBp(TestVBp)
-  ) u_timing (
+  de_video_timing #(.TestMode(TestMode)) u_timing (
     .clk_i, .rst_i, .mode_i,
     .h_o(h), .v_o(v), .h_total_o(h_total), .v_total_o(v_total), .v_active_o(v_active),
     .hsync_o(t_hsync), .vsync_o(t_vsync), .de_o(t_de), .hpol_o(hpol), .vpol_o(vpol),
@@ -327,8 +317,8 @@ module de_access_ctrl #(
         assert (h == 12'd0 && f_since_refresh == '0);
       end
       assert (32'(owner_q) < NumBuf);
-      assert (h_total == 12'(TestHActive + TestHFp + TestHSync + TestHBp));
-      assert (v_total == 12'(TestVActive + TestVFp + TestVSync + TestVBp));
+      assert (h_total == TestMode.h_act + TestMode.h_fp + TestMode.h_sync + TestMode.h_bp);
+      assert (v_total == TestMode.v_act + TestMode.v_fp + TestMode.v_sync + TestMode.v_bp);
       assert (h < h_total && v < v_total);
     end
   end

@@ -23,14 +23,8 @@ module de_display_core #(
   parameter int unsigned NumBins      = 16,
   parameter int unsigned BinShift     = 7,
   parameter int unsigned MaxLines     = 1024,
-  parameter int unsigned TestHActive  = 16,
-  parameter int unsigned TestHFp      = 2,
-  parameter int unsigned TestHSync    = 3,
-  parameter int unsigned TestHBp      = 3,
-  parameter int unsigned TestVActive  = 6,
-  parameter int unsigned TestVFp      = 1,
-  parameter int unsigned TestVSync    = 2,
-  parameter int unsigned TestVBp      = 2,
+  // Mode 3's geometry (de_video_timing).
+  parameter de_pkg::video_mode_t TestMode = de_pkg::VideoTestDefault,
   localparam int unsigned NumCh       = 3
 ) (
   input  logic                                 clk_i,
@@ -116,14 +110,7 @@ module de_display_core #(
       .NumBuf      (NumBuf),
       .ArrayLatency(ArrayLatency),
       .SkipW       (SkipW),
-      .TestHActive (TestHActive),
-      .TestHFp     (TestHFp),
-      .TestHSync   (TestHSync),
-      .TestHBp     (TestHBp),
-      .TestVActive (TestVActive),
-      .TestVFp     (TestVFp),
-      .TestVSync   (TestVSync),
-      .TestVBp     (TestVBp)
+      .TestMode    (TestMode)
     ) u_ac (
       .clk_i,
       .rst_i,

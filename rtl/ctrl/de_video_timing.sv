@@ -13,14 +13,7 @@
 
 module de_video_timing #(
   // Mode 3 ("test mode"): small totals for fast simulation and formal checks.
-  parameter int unsigned TestHActive = 16,
-  parameter int unsigned TestHFp     = 2,
-  parameter int unsigned TestHSync   = 3,
-  parameter int unsigned TestHBp     = 3,
-  parameter int unsigned TestVActive = 6,
-  parameter int unsigned TestVFp     = 1,
-  parameter int unsigned TestVSync   = 2,
-  parameter int unsigned TestVBp     = 2
+  parameter de_pkg::video_mode_t TestMode = de_pkg::VideoTestDefault
 ) (
   input  logic        clk_i,
   input  logic        rst_i,
@@ -43,11 +36,13 @@ module de_video_timing #(
   output logic [11:0] next_line_o         // v+1 (mod total)
 );
 
-  localparam int unsigned TestHTotal = TestHActive + TestHFp + TestHSync + TestHBp;
-  localparam int unsigned TestVTotal = TestVActive + TestVFp + TestVSync + TestVBp;
+  localparam int unsigned TestHTotal = int'(TestMode.h_act) + int'(TestMode.h_fp)
+                                     + int'(TestMode.h_sync) + int'(TestMode.h_bp);
+  localparam int unsigned TestVTotal = int'(TestMode.v_act) + int'(TestMode.v_fp)
+                                     + int'(TestMode.v_sync) + int'(TestMode.v_bp);
 
   // Parameter checks at elaboration.
-  if (TestHActive < 1 || TestHSync < 1 || TestVActive < 1 || TestVSync < 1)
+  if (TestMode.h_act < 1 || TestMode.h_sync < 1 || TestMode.v_act < 1 || TestMode.v_sync < 1)
   begin : g_bad_test_zero
     $fatal(1, "de_video_timing: test mode needs non-zero active and sync widths");
   end
@@ -57,7 +52,7 @@ module de_video_timing #(
   end
 
   // Mode table: spec/video.toml through de_pkg::video_mode (docs/display-controller.md
-  // §3); the test mode's geometry comes from the Test* parameters. Package names are
+  // §3); the test mode's geometry comes from the TestMode parameter. Package names are
   // written qualified: tb/formal reads this file with yosys's own parser, which has no
   // `import`.
   logic [11:0] h_act, h_fp, h_sync, h_bp, v_act, v_fp, v_sync, v_bp;
@@ -71,8 +66,7 @@ module de_video_timing #(
 
   function automatic de_pkg::video_mode_t mode_of(logic [1:0] m);
     if (m == de_pkg::VideoModeTest) begin
-      mode_of = {12'(TestHActive), 12'(TestHFp), 12'(TestHSync), 12'(TestHBp),
-                 12'(TestVActive), 12'(TestVFp), 12'(TestVSync), 12'(TestVBp), 1'b0, 1'b0};
+      mode_of = TestMode;
     end else begin
       mode_of = de_pkg::video_mode(m);
     end

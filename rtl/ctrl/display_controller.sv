@@ -90,6 +90,12 @@ module display_controller #(
   logic [NumCh-1:0][11:0] pix;
   logic [NumCh-1:0]       pix_valid;
 
+  // The test mode's geometry as one value (its scalar parameters are what the testbenches
+  // and sim/dc's -G set; below the tops it travels as one de_pkg::video_mode_t).
+  localparam de_pkg::video_mode_t TestMode = {
+    12'(TestHActive), 12'(TestHFp), 12'(TestHSync), 12'(TestHBp),
+    12'(TestVActive), 12'(TestVFp), 12'(TestVSync), 12'(TestVBp), 2'b00};
+
   de_display_core #(
     .NumBuf      (NumBuf),
     .BufDepth    (BufDepth),
@@ -98,14 +104,7 @@ module display_controller #(
     .NumBins     (NumBins),
     .BinShift    (BinShift),
     .MaxLines    (MaxLines),
-    .TestHActive (TestHActive),
-    .TestHFp     (TestHFp),
-    .TestHSync   (TestHSync),
-    .TestHBp     (TestHBp),
-    .TestVActive (TestVActive),
-    .TestVFp     (TestVFp),
-    .TestVSync   (TestVSync),
-    .TestVBp     (TestVBp)
+    .TestMode    (TestMode)
   ) u_core (
     .clk_i,
     .rst_i,

@@ -115,42 +115,21 @@ package de_pkg;
 
   function automatic logic [1:0] lut_type(input logic [LutCodeW-1:0] code);
     case (code)
-      5'd0: lut_type = TypeNone;
-      5'd1: lut_type = TypeNone;
-      5'd2: lut_type = TypeNone;
-      5'd3: lut_type = TypeNone;
-      5'd4: lut_type = TypeAddress;
-      5'd5: lut_type = TypeAddress;
-      5'd6: lut_type = TypeAddress;
-      5'd7: lut_type = TypeAddress;
-      5'd8: lut_type = TypeNone;
-      5'd9: lut_type = TypeIntensity;
-      5'd10: lut_type = TypeIntensity;
-      5'd11: lut_type = TypeIntensity;
-      5'd12: lut_type = TypeIntensity;
-      5'd13: lut_type = TypeIntensity;
-      5'd14: lut_type = TypeIntensity;
-      5'd15: lut_type = TypeIntensity;
-      5'd16: lut_type = TypeIntensity;
-      5'd17: lut_type = TypeIntensity;
-      5'd18: lut_type = TypeIntensity;
+      5'd0, 5'd1, 5'd2, 5'd3, 5'd8:
+        lut_type = TypeNone;
+      5'd4, 5'd5, 5'd6, 5'd7:
+        lut_type = TypeAddress;
+      5'd9, 5'd10, 5'd11, 5'd12, 5'd13, 5'd14, 5'd15, 5'd16, 5'd17, 5'd18:
+        lut_type = TypeIntensity;
       default: lut_type = TypeNone;
     endcase
   endfunction
 
   // ---- field selects ----
-  // Register read port: code RegNone reads as zero ("adds 0"); one block, a word, a flag.
-  function automatic logic [BlkW-1:0] reg_blk(input logic [1:0] code, input logic [BlkW-1:0] a,
-                                input logic [BlkW-1:0] b, input logic [BlkW-1:0] c);
-    case (code)
-      RegA:    reg_blk = a;
-      RegB:    reg_blk = b;
-      RegC:    reg_blk = c;
-      default: reg_blk = '0;
-    endcase
-  endfunction
-  function automatic logic [DataW-1:0] reg_word(input logic [1:0] code, input logic [DataW-1:0] a,
-                                input logic [DataW-1:0] b, input logic [DataW-1:0] c);
+  // Register read port: code RegNone reads as zero ("adds 0"); a word, and through
+  // it one block (de_pe) and a flag.
+  function automatic logic [DataW-1:0] reg_word(input logic [1:0] code,
+      input logic [DataW-1:0] a, input logic [DataW-1:0] b, input logic [DataW-1:0] c);
     case (code)
       RegA:    reg_word = a;
       RegB:    reg_word = b;
@@ -158,14 +137,13 @@ package de_pkg;
       default: reg_word = '0;
     endcase
   endfunction
+  function automatic logic [BlkW-1:0] reg_blk(input logic [1:0] code, input logic [BlkW-1:0] a,
+                                input logic [BlkW-1:0] b, input logic [BlkW-1:0] c);
+    reg_blk = BlkW'(reg_word(code, DataW'(a), DataW'(b), DataW'(c)));
+  endfunction
   function automatic logic reg_flag(input logic [1:0] code, input logic a,
                                 input logic b, input logic c);
-    case (code)
-      RegA:    reg_flag = a;
-      RegB:    reg_flag = b;
-      RegC:    reg_flag = c;
-      default: reg_flag = 1'b0;
-    endcase
+    reg_flag = 1'(reg_word(code, DataW'(a), DataW'(b), DataW'(c)));
   endfunction
   // One instruction as the y-processor and the controller store it: {identifier, data}.
   localparam int unsigned RecW = IdW + DataW;
@@ -227,6 +205,10 @@ package de_pkg;
     logic        h_pol, v_pol;  // 1 = active-high sync pulse
   } video_mode_t;
   localparam logic [1:0] VideoModeTest = 2'd3;
+  // The test mode's default geometry (the Test* parameters of the tops).
+  localparam video_mode_t VideoTestDefault = {12'd16, 12'd2, 12'd3, 12'd3,
+                                            12'd6, 12'd1, 12'd2, 12'd2,
+                                            1'b0, 1'b0};
 
   // The fixed modes by index; the test mode (and any other index) returns mode 0,
   // its geometry comes from de_video_timing's parameters.

@@ -38,6 +38,7 @@
 
 #include "Vdisplay_controller.h"
 #include "de_isa.h"
+#include "de_verilated.h"
 #include "verilated.h"
 #include <ctime>
 #include <unistd.h>
@@ -210,22 +211,14 @@ int main(int argc, char** argv) {
   auto ctx = std::make_unique<VerilatedContext>();
   ctx->commandArgs(1, argv);
   auto top = std::make_unique<Vdisplay_controller>(ctx.get());
-  auto tick = [&]() {
-    top->clk_i = 0;
-    top->eval();
-    top->clk_i = 1;
-    top->eval();
-  };
+  auto tick = [&]() { de_sim::tick(*top); };
   top->rst_i = 1;
   top->mode_i = mode;
   top->wr_valid_i = 0;
   top->reg_addr_i = (DE_REG_INFO_CHAN << DE_REG_CHAN_LSB) | DE_CTRL_REG_ID;
   top->out8_shift_i = 4;
   top->out8_sat_i = 0;
-  top->cfg_mode_i = 0;
-  top->cfg_bit_i = 0;
-  top->obs_load_i = 0;
-  top->obs_shift_i = 0;
+  de_sim::chains_idle(*top);
   for (int i = 0; i < 4; ++i) tick();
   top->rst_i = 0;
   tick();  // the controller's registers read one clock after the address (blank lines)

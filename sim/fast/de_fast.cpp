@@ -15,6 +15,7 @@
 #include "Vde_fast_unit.h"
 #include "Vde_fast_unit__Syms.h"
 #include "Vde_fast_unit___024root.h"
+#include "de_verilated.h"
 #include "svdpi.h"
 #include "verilated.h"
 
@@ -113,13 +114,7 @@ inline void take_bus(Dst& d, const Src& s) {
 Out Array::step(const In& in) {
   // 1. The head's core is combinational from id_i/data_i: settle it for this cycle.
   Vde_fast_head& h = *head_;
-  h.rst_i = in.rst;
-  h.id_i = in.ident;
-  h.data_i = in.data;
-  h.cfg_mode_i = in.cfg_mode;
-  h.cfg_bit_i = in.cfg_bit;
-  h.obs_load_i = in.obs_load;
-  h.obs_shift_i = in.obs_shift;
+  de_sim::drive(h, in);
   eval(h);
 
   // 2. Tail first, then the units from the last to the first: each piece reads its

@@ -16,6 +16,7 @@
 #include "Vflat.h"
 #include "de_fast.h"
 #include "de_isa.h"
+#include "de_verilated.h"
 #include "verilated.h"
 
 int main(int argc, char** argv) {
@@ -78,17 +79,8 @@ int main(int argc, char** argv) {
     stats_rst += in.rst;
 
     Vflat& f = *flat;
-    f.rst_i = in.rst;
-    f.id_i = in.ident;
-    f.data_i = in.data;
-    f.cfg_mode_i = in.cfg_mode;
-    f.cfg_bit_i = in.cfg_bit;
-    f.obs_load_i = in.obs_load;
-    f.obs_shift_i = in.obs_shift;
-    f.clk_i = 0;
-    f.eval();
-    f.clk_i = 1;
-    f.eval();
+    de_sim::drive(f, in);
+    de_sim::tick(f);
     const de_fast::Out o = fast.step(in);
     stats_pix += o.pixel_valid;
     const bool same = o.ident == f.id_o && o.data == f.data_o &&

@@ -17,7 +17,7 @@ FAST_SHELL := $(ROOT)/sim/fast/de_array.sv
 FAST_CPP := $(ROOT)/sim/fast/de_fast.cpp
 FAST_LIBS := $(foreach p,head unit tail,$(FAST_DIR)/$(p)/Vde_fast_$(p)__ALL.a)
 FAST_VFLAGS := -CFLAGS "-I$(FAST_DIR)/head -I$(FAST_DIR)/unit -I$(FAST_DIR)/tail \
-  -I$(ROOT)/sim/fast -I$(ROOT)/sw/include -DDE_FAST_NUM_PE=9 -DDE_FAST_CARRY_BUG=$(CARRY_BUG)" \
+  -I$(ROOT)/sim/fast -I$(ROOT)/sim/include -I$(ROOT)/sw/include -DDE_FAST_NUM_PE=9 -DDE_FAST_CARRY_BUG=$(CARRY_BUG)" \
   $(if $(FAST_LDFLAGS),-LDFLAGS "$(FAST_LDFLAGS)",)
 
 # Always asks the pieces' own make (cheap when they are up to date), under a lock.

@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "de_isa.h"
+#include "de_verilated.h"
 #include <vector>
 
 #include "Vde_array.h"
@@ -714,19 +715,11 @@ int main(int argc, char** argv) {
   };
 #endif
 
-  auto tick = [&]() {
-    top->clk_i = 0;
-    top->eval();
-    top->clk_i = 1;
-    top->eval();
-  };
+  auto tick = [&]() { de_sim::tick(*top); };
   top->rst_i = 1;
   top->id_i = 0;
   top->data_i = 0;
-  top->cfg_mode_i = 0;
-  top->cfg_bit_i = 0;
-  top->obs_load_i = 0;
-  top->obs_shift_i = 0;
+  de_sim::chains_idle(*top);
   for (int i = 0; i < 4; ++i) tick();
   top->rst_i = 0;
 
@@ -738,6 +731,24 @@ int main(int argc, char** argv) {
   uint64_t first_i = 0;  // where the first repeat starts in the flat model
 #if defined(DE_TRACE) && defined(DE_FASTFWD)
   std::unique_ptr<de_fast::Array> fa;  // the fast array, while it holds the state
+  // Slot k of the stream through the fast array: the pixel, its trace, the collision.
+  auto fast_step = [&](uint64_t k) {
+    de_fast::In in;
+    in.ident = seq[k].ident;
+    in.data = seq[k].data;
+    const de_fast::Out fo = fa->step(in);
+    if (fo.pixel_valid) pixels.push_back(fo.pixel);
+    if (o.trace_pixels && fo.pixel_valid)
+      std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(k + 1),
+                  pixels.size() - 1, fo.pixel);
+    if (o.trace_pixels && seq[k].ident == kRefresh)
+      std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(k + 1));
+    if (fo.collision && !collided) {
+      collided = true;
+      std::fprintf(stderr, "%s: pixel collision at cycle %llu\n", argv[1],
+                   static_cast<unsigned long long>(k + 1));
+    }
+  };
   // Nothing is observed before the window (or the breakpoint cycle), so those cycles run
   // in the fast array; an opcode breakpoint watches every cycle and turns this off.
   uint64_t ffwd = (!o.fst.empty() || !o.csv.empty()) ? w_from : UINT64_MAX;
@@ -751,24 +762,7 @@ int main(int argc, char** argv) {
     de_fast::In rin;
     rin.rst = true;
     for (int k = 0; k < 4; ++k) fa->step(rin);
-    de_fast::Out fo;
-    for (uint64_t i = 0; i < ffwd; ++i) {
-      de_fast::In in;
-      in.ident = seq[i].ident;
-      in.data = seq[i].data;
-      fo = fa->step(in);
-      if (fo.pixel_valid) pixels.push_back(fo.pixel);
-      if (o.trace_pixels && fo.pixel_valid)
-        std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(i + 1),
-                    pixels.size() - 1, fo.pixel);
-      if (o.trace_pixels && seq[i].ident == kRefresh)
-        std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(i + 1));
-      if (fo.collision && !collided) {
-        collided = true;
-        std::fprintf(stderr, "%s: pixel collision at cycle %llu\n", argv[1],
-                     static_cast<unsigned long long>(i + 1));
-      }
-    }
+    for (uint64_t i = 0; i < ffwd; ++i) fast_step(i);
     long copied = 0;
     if (!hand_over(*fa, *ctx, *top, n_chips, true, copied, err)) {
       std::fprintf(stderr, "%s: %s\n", argv[0], err.c_str());
@@ -867,24 +861,7 @@ int main(int argc, char** argv) {
           return 1;
         }
         Verilated::threadContextp(ctx.get());
-        de_fast::Out fo;
-        for (uint64_t k = i + 1; k < play; ++k) {
-          de_fast::In in;
-          in.ident = seq[k].ident;
-          in.data = seq[k].data;
-          fo = fa->step(in);
-          if (fo.pixel_valid) pixels.push_back(fo.pixel);
-          if (o.trace_pixels && fo.pixel_valid)
-            std::printf("cycle %llu pixel %zu = %u\n", static_cast<unsigned long long>(k + 1),
-                        pixels.size() - 1, fo.pixel);
-          if (o.trace_pixels && seq[k].ident == kRefresh)
-            std::printf("cycle %llu Refresh in\n", static_cast<unsigned long long>(k + 1));
-          if (fo.collision && !collided) {
-            collided = true;
-            std::fprintf(stderr, "%s: pixel collision at cycle %llu\n", argv[1],
-                         static_cast<unsigned long long>(k + 1));
-          }
-        }
+        for (uint64_t k = i + 1; k < play; ++k) fast_step(k);
         handed_back = true;
         std::fprintf(stderr, "harness: after the window, %llu cycles back in the fast array "
                      "(%.2f s)\n", static_cast<unsigned long long>(play - i - 1),

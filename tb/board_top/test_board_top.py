@@ -68,14 +68,8 @@ PIX_PS = 40000          # pixel clock period (25 MHz)
 async def test_tmds_encoder(dut):
     from common.run import seed_from_env
     rng = random.Random(seed_from_env())
-    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
-    dut.rst_i.value = 1
-    dut.de_i.value = 0
-    dut.data_i.value = 0
-    dut.c_i.value = 0
-    await ClockCycles(dut.clk_i, 2)
-    await FallingEdge(dut.clk_i)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 2, clock_ns=10, de_i=0, data_i=0, c_i=0)
 
     model = tmds.Encoder()
     reach = tmds.reachable_disparity()
@@ -350,12 +344,8 @@ async def reset(dut, g):
     # The core clock (the UART's, and the span-serial arrays' when SpanArray = 1),
     # unrelated in phase to the pixel clock, at UartClkHz to the nearest picosecond.
     cocotb.start_soon(Clock(dut.clk_core_i, round(1e12 / g["UartClkHz"]), unit="ps").start())
-    dut.rst_i.value = 1
-    dut.mode_i.value = 3
-    dut.uart_rx_i.value = 1
-    await ClockCycles(dut.clk_i, 5)
-    await FallingEdge(dut.clk_i)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 5, mode_i=3, uart_rx_i=1)
 
 
 def check_switch(frames, old, new, what):

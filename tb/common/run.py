@@ -29,8 +29,11 @@ def rtl_files(core: str, target: str = "default") -> list[Path]:
 
 def build_and_test(tb_dir: Path, toplevel: str, sources: list[Path], test_module: str,
                    parameters: dict | None = None, extra_env: dict | None = None,
-                   testcase: str | None = None, waves: bool = False) -> None:
-    """Build `toplevel` from `sources` (cached per parameter set) and run `test_module`."""
+                   testcase: str | None = None, waves: bool = False,
+                   lint: bool = False) -> None:
+    """Build `toplevel` from `sources` (cached per parameter set) and run `test_module`.
+    lint=True builds with Verilator -Wall as an error (the blocks whose testbench is
+    also their lint gate), otherwise warnings do not stop the build."""
     parameters = parameters or {}
     tag = "_".join(f"{k}{v}" for k, v in sorted(parameters.items())) or "default"
     build_dir = tb_dir / f"sim_build_{tag}"
@@ -46,7 +49,8 @@ def build_and_test(tb_dir: Path, toplevel: str, sources: list[Path], test_module
         hdl_toplevel=toplevel,
         parameters=parameters,
         build_dir=build_dir,
-        build_args=["-Wno-fatal", "-MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include"]
+        build_args=(["-Wall", "-O1"] if lint else ["-Wno-fatal"])
+        + ["-MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include"]
         + (["-MAKEFLAGS", f"OBJCACHE={cache}"] if cache else [])
         + (["--trace-fst", "--trace-structs"] if waves else []),
         waves=waves,
@@ -72,3 +76,23 @@ def seed_from_env(default: int | None = None) -> int:
                               else int.from_bytes(os.urandom(4), "little")))
     print(f"SEED={seed}  (re-run with SEED={seed})", file=sys.stderr)
     return seed
+
+
+async def hold_reset(dut, rises: int, *, falling: bool = True, clock_ns: float | None = None,
+                     **inputs) -> None:
+    """The testbenches' reset: optionally start a clock_ns clock on clk_i, raise rst_i
+    with the given inputs driven (name=value), wait `rises` rising edges of clk_i and,
+    with `falling`, the falling edge after them, then release rst_i."""
+    import cocotb
+    from cocotb.clock import Clock
+    from cocotb.triggers import FallingEdge, RisingEdge
+    if clock_ns is not None:
+        cocotb.start_soon(Clock(dut.clk_i, clock_ns, unit="ns").start())
+    dut.rst_i.value = 1
+    for name, value in inputs.items():
+        getattr(dut, name).value = value
+    for _ in range(rises):
+        await RisingEdge(dut.clk_i)
+    if falling:
+        await FallingEdge(dut.clk_i)
+    dut.rst_i.value = 0

@@ -54,12 +54,8 @@ def now() -> int:
 
 
 async def reset(dut, mode: int):
-    dut.rst_i.value = 1
-    dut.mode_i.value = mode
-    dut.buf_valid_i.value = 0
-    dut.buf_data_i.value = 0
-    await ClockCycles(dut.clk_i, 3)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 3, falling=False, mode_i=mode, buf_valid_i=0, buf_data_i=0)
 
 
 async def edges(sig, rises: list, falls: list):
@@ -353,29 +349,13 @@ async def test_random_vs_model(dut):
 
 
 def _build_and_run(num_buf: int, latency: int, all_modes: bool):
-    from cocotb_tools.runner import get_runner
-    from common.run import rtl_files
+    from common.run import build_and_test, rtl_files
 
-    sys.path.insert(0, str(HERE))
     seed = get_seed()
     print(f"de_access_ctrl NumBuf={num_buf} ArrayLatency={latency} SEED={seed}")
-    runner = get_runner("verilator")
-    build_dir = HERE / f"sim_build_NumBuf{num_buf}_Lat{latency}"
-    params = {"NumBuf": num_buf, "ArrayLatency": latency}
-    runner.build(
-        sources=rtl_files("display_core", "access_ctrl"),
-        hdl_toplevel="de_access_ctrl",
-        parameters=params,
-        build_dir=build_dir,
-        build_args=["-Wall", "-O1"],
-    )
-    runner.test(
-        hdl_toplevel="de_access_ctrl",
-        test_module="test_de_access_ctrl",
-        build_dir=build_dir,
-        test_dir=build_dir,
-        extra_env={"SEED": str(seed), "DE_ALL_MODES": "1" if all_modes else "0"},
-    )
+    build_and_test(HERE, "de_access_ctrl", rtl_files("display_core", "access_ctrl"),
+                   "test_de_access_ctrl", {"NumBuf": num_buf, "ArrayLatency": latency},
+                   {"SEED": str(seed), "DE_ALL_MODES": "1" if all_modes else "0"}, lint=True)
 
 
 @pytest.mark.parametrize("num_buf,latency,all_modes", [(8, 3, True), (3, 0, False),

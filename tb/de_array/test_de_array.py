@@ -65,15 +65,9 @@ class Array:
         self.pixel_edges: list[int] = []    # edge after which each pixel was on the output
 
     async def reset(self):
-        d = self.dut
-        for sig in (d.id_i, d.data_i, d.cfg_mode_i, d.cfg_bit_i, d.obs_load_i,
-                    d.obs_shift_i):
-            sig.value = 0
-        d.rst_i.value = 1
-        for _ in range(3):
-            await RisingEdge(d.clk_i)
-        await FallingEdge(d.clk_i)
-        d.rst_i.value = 0
+        from common.run import hold_reset
+        await hold_reset(self.dut, 3, id_i=0, data_i=0, cfg_mode_i=0, cfg_bit_i=0,
+                         obs_load_i=0, obs_shift_i=0)
         if self.model:
             self.model.reset()
 

@@ -10,7 +10,6 @@ import random
 from pathlib import Path
 
 import cocotb
-from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from diffengine.formats.binfmt import map_word
@@ -22,15 +21,9 @@ N_WORDS = 4000
 async def mapper_matches_model(dut):
     from common.run import seed_from_env
     rng = random.Random(seed_from_env())
-    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
-    dut.rst_i.value = 1
-    dut.valid_i.value = 0
-    dut.word_i.value = 0
-    dut.window_i.value = 0
-    dut.compensate_i.value = 0
-    for _ in range(3):
-        await RisingEdge(dut.clk_i)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 3, falling=False, clock_ns=10, valid_i=0, word_i=0, window_i=0,
+                     compensate_i=0)
 
     history: list[tuple[int, int]] = []  # (ident, data) seen at the mapper output
     checked = 0

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import cocotb
 import pytest
-from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
 HERE = Path(__file__).resolve().parent
@@ -64,15 +63,9 @@ def get_seed() -> int:
 
 
 async def reset(dut):
-    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
-    dut.rst_i.value = 1
-    dut.wr_valid_i.value = 0
-    dut.wr_data_i.value = 0
-    dut.rd_ready_i.value = 0
-    dut.drain_i.value = 0
-    for _ in range(3):
-        await RisingEdge(dut.clk_i)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 3, falling=False, clock_ns=10, wr_valid_i=0, wr_data_i=0,
+                     rd_ready_i=0, drain_i=0)
 
 
 async def run_random(dut, seed: int, wr_p: float, rd_p: float, n_lines: int, max_cmds: int,
@@ -177,28 +170,14 @@ async def test_commit_gating(dut):
 
 
 def _build_and_run(depth: int, max_cmd_len: int):
-    from cocotb_tools.runner import get_runner
-    from common.run import rtl_files
+    from common.run import build_and_test, rtl_files
 
-    sys.path.insert(0, str(HERE))
     seed = get_seed()
     print(f"de_instr_buffer Depth={depth} MaxCmdLen={max_cmd_len} SEED={seed}")
-    runner = get_runner("verilator")
-    build_dir = HERE / f"sim_build_Depth{depth}_MaxCmdLen{max_cmd_len}"
-    runner.build(
-        sources=rtl_files("display_core", "instr_buffer"),   # rtl/ctrl/de_display_core.core
-        hdl_toplevel="de_instr_buffer",
-        parameters={"Depth": depth, "MaxCmdLen": max_cmd_len},
-        build_dir=build_dir,
-        build_args=["-Wall", "-O1"],
-    )
-    runner.test(
-        hdl_toplevel="de_instr_buffer",
-        test_module="test_de_instr_buffer",
-        build_dir=build_dir,
-        test_dir=build_dir,
-        extra_env={"SEED": str(seed)},
-    )
+    # rtl/ctrl/de_display_core.core
+    build_and_test(HERE, "de_instr_buffer", rtl_files("display_core", "instr_buffer"),
+                   "test_de_instr_buffer", {"Depth": depth, "MaxCmdLen": max_cmd_len},
+                   {"SEED": str(seed)}, lint=True)
 
 
 @pytest.mark.parametrize("depth,max_cmd_len", [(4, 3), (16, 10)])

@@ -11,13 +11,12 @@ from __future__ import annotations
 
 import os
 import random
-import sys
 from pathlib import Path
 
 import cocotb
 import pytest
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
+from cocotb.triggers import ReadOnly, RisingEdge
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -99,12 +98,8 @@ async def test_counts_under_overload(dut):
     shift = int(dut.BinShift.value)
     ev = ["ev_refresh_i", "ev_line_active_i", "ev_line_i", "ev_last_line_i", "ev_late_i",
           "ev_issue_i", "ev_free_i", "drop_i"]
-    dut.rst_i.value = 1
-    for name in ev:
-        getattr(dut, name).value = 0
-    dut.reg_addr_i.value = 0
-    await ClockCycles(dut.clk_i, 3)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 3, falling=False, reg_addr_i=0, **dict.fromkeys(ev, 0))
     assert await read_reg(dut, 0) == (0xDE << 24) | (bins << 16) | (shift << 12) | (nb << 8) | 1
     model = Model(nb, bins, shift)
     full = (1 << nb) - 1
@@ -151,29 +146,14 @@ async def test_counts_under_overload(dut):
 
 
 def _build_and_run(nb: int, bins: int, shift: int):
-    from cocotb_tools.runner import get_runner
-    from common.run import rtl_files
+    from common.run import build_and_test, rtl_files
 
-    sys.path.insert(0, str(HERE))
     seed = get_seed()
     print(f"de_load_monitor NumBuf={nb} NumBins={bins} BinShift={shift} SEED={seed}")
-    runner = get_runner("verilator")
-    build_dir = HERE / f"sim_build_NumBuf{nb}_Bins{bins}_Shift{shift}"
     params = {"NumBuf": nb, "NumBins": bins, "BinShift": shift, "MaxLines": 16}
-    runner.build(
-        sources=rtl_files("display_core", "load_monitor"),   # rtl/ctrl/de_display_core.core
-        hdl_toplevel="de_load_monitor",
-        parameters=params,
-        build_dir=build_dir,
-        build_args=["-Wall", "-O1"],
-    )
-    runner.test(
-        hdl_toplevel="de_load_monitor",
-        test_module="test_de_load_monitor",
-        build_dir=build_dir,
-        test_dir=build_dir,
-        extra_env={"SEED": str(seed)},
-    )
+    # rtl/ctrl/de_display_core.core
+    build_and_test(HERE, "de_load_monitor", rtl_files("display_core", "load_monitor"),
+                   "test_de_load_monitor", params, {"SEED": str(seed)}, lint=True)
 
 
 @pytest.mark.parametrize("nb,bins,shift", [(8, 5, 2), (1, 3, 3)])

@@ -8,8 +8,7 @@ import random
 from pathlib import Path
 
 import cocotb
-from cocotb.clock import Clock
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import FallingEdge, ReadOnly
 
 
 @cocotb.test()
@@ -17,14 +16,8 @@ async def in_order_no_loss(dut):
     seed = int(os.environ.get("SEED", random.randrange(1 << 31)))
     dut._log.info(f"SEED={seed} (replay with SEED={seed})")
     rng = random.Random(seed)
-    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
-    dut.rst_i.value = 1
-    dut.valid_i.value = 0
-    dut.ready_i.value = 0
-    dut.data_i.value = 0
-    await RisingEdge(dut.clk_i)
-    await FallingEdge(dut.clk_i)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 1, clock_ns=10, valid_i=0, ready_i=0, data_i=0)
     words = [rng.randrange(1 << 48) for _ in range(3000)]
     sent, got, i = 0, [], 0
     for cyc in range(20000):

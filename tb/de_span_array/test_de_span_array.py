@@ -53,14 +53,8 @@ class Bench:
                     self.refresh_cycles.append(self.cycle)
 
     async def reset(self):
-        d = self.dut
-        d.instr_valid_i.value = 0
-        d.id_i.value = 0
-        d.data_i.value = 0
-        d.rst_i.value = 1
-        await RisingEdge(d.clk_i)
-        await FallingEdge(d.clk_i)
-        d.rst_i.value = 0
+        from common.run import hold_reset
+        await hold_reset(self.dut, 1, instr_valid_i=0, id_i=0, data_i=0)
 
     async def offer(self, ident: int, data: int):
         """Hold one slot on the port until the array takes it (ready in the same clock);

@@ -366,20 +366,10 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
     n_lines = frames * g["TestVActive"]
     streams = make_streams(seed, g, n_lines, per_line, max_words)
     bench = Bench(dut, g, streams, stall_p, seed, skip_late)
-    dut.rst_i.value = 1
-    dut.mode_i.value = 3
-    dut.wr_valid_i.value = 0
-    dut.wr_data_i.value = 0
-    dut.reg_addr_i.value = 0
-    dut.out8_shift_i.value = w8
-    dut.out8_sat_i.value = int(sat8)
-    dut.cfg_mode_i.value = 0
-    dut.cfg_bit_i.value = 0
-    dut.obs_load_i.value = 0
-    dut.obs_shift_i.value = 0
-    await ClockCycles(dut.clk_i, 3)
-    await FallingEdge(dut.clk_i)
-    dut.rst_i.value = 0
+    from common.run import hold_reset
+    await hold_reset(dut, 3, mode_i=3, wr_valid_i=0, wr_data_i=0, reg_addr_i=0,
+                     out8_shift_i=w8, out8_sat_i=int(sat8), cfg_mode_i=0, cfg_bit_i=0,
+                     obs_load_i=0, obs_shift_i=0)
     cocotb.start_soon(bench.monitor())
     cocotb.start_soon(bench.drive())
     ht, vt, va = g["HTotal"], g["VTotal"], g["TestVActive"]

@@ -54,6 +54,14 @@ def harness_exe(bug=0, trace_build=True, threads=1) -> Path:
     return harness.build(CHIPS, bool(bug), threads, trace=trace_build)
 
 
+def stream_on_disk(stream, tmp_path):
+    """The trace build, the random stream as tmp_path/in.de48 and its timing."""
+    _, slots = stream
+    src = tmp_path / "in.de48"
+    src.write_bytes(binfmt.encode_de48(slots))
+    return harness_exe(), src, trace.Timing.of(slots, CHIPS)
+
+
 def run(exe, src, dst, *args, rc=0) -> subprocess.CompletedProcess:
     res = subprocess.run([str(exe), str(src), str(dst), *map(str, args)],
                          capture_output=True, text=True)
@@ -79,11 +87,7 @@ def have_fst2vcd() -> bool:
 
 
 def test_fst_window_is_small_and_exact(stream, tmp_path):
-    _, slots = stream
-    exe = harness_exe()
-    src = tmp_path / "in.de48"
-    src.write_bytes(binfmt.encode_de48(slots))
-    t = trace.Timing.of(slots, CHIPS)
+    exe, src, t = stream_on_disk(stream, tmp_path)
     assert len(t.refresh_at) >= 4, "the stream should have a few lines"
     lo, hi = t.line_window(1)
     res = run(exe, src, tmp_path / "a.depx", "--fst", tmp_path / "line.fst", "--line", 1,
@@ -130,10 +134,7 @@ def test_trace_csv_equals_structural_model(stream, tmp_path):
 
 def test_breakpoints_stop_at_the_right_cycle(stream, tmp_path):
     _, slots = stream
-    exe = harness_exe()
-    src = tmp_path / "in.de48"
-    src.write_bytes(binfmt.encode_de48(slots))
-    t = trace.Timing.of(slots, CHIPS)
+    exe, src, t = stream_on_disk(stream, tmp_path)
 
     def stopped(res) -> tuple[int, list[str]]:
         lines = res.stdout.splitlines()

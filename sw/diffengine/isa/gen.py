@@ -172,18 +172,27 @@ def gen_sv(spec: dict) -> str:
           "  function automatic logic [1:0] lut_type(input logic [LutCodeW-1:0] code);",
           "    case (code)"]
     types = {"none": "TypeNone", "address": "TypeAddress", "intensity": "TypeIntensity"}
+    # One case item per operand type, listing its codes.
+    codes: dict[str, list[str]] = {}
     for i, (_, _, t) in enumerate(lut(spec)):
-        o.append(f"      {cw}'d{i}: lut_type = {types[t]};")
+        codes.setdefault(t, []).append(f"{cw}'d{i}")
+    for t, cs in codes.items():
+        o.append(f"      {', '.join(cs)}:")
+        o.append(f"        lut_type = {types[t]};")
     o += ["      default: lut_type = TypeNone;", "    endcase", "  endfunction", "",
           "  // ---- field selects ----",
-          "  // Register read port: code RegNone reads as zero (\"adds 0\"); one block, a word, a flag."]
-    for fn, typ in (("reg_blk", "logic [BlkW-1:0]"), ("reg_word", "logic [DataW-1:0]"),
-                    ("reg_flag", "logic")):
-        zero = "1'b0" if typ == "logic" else "'0"
+          "  // Register read port: code RegNone reads as zero (\"adds 0\"); a word, and through",
+          "  // it one block (de_pe) and a flag.",
+          "  function automatic logic [DataW-1:0] reg_word(input logic [1:0] code,",
+          "      input logic [DataW-1:0] a, input logic [DataW-1:0] b, input logic [DataW-1:0] c);",
+          "    case (code)", "      RegA:    reg_word = a;", "      RegB:    reg_word = b;",
+          "      RegC:    reg_word = c;", "      default: reg_word = '0;", "    endcase",
+          "  endfunction"]
+    for fn, w in (("reg_blk", "BlkW"), ("reg_flag", "1")):
+        typ = "logic" if w == "1" else f"logic [{w}-1:0]"
         o += [f"  function automatic {typ} {fn}(input logic [1:0] code, input {typ} a,",
               f"                                input {typ} b, input {typ} c);",
-              "    case (code)", f"      RegA:    {fn} = a;", f"      RegB:    {fn} = b;",
-              f"      RegC:    {fn} = c;", f"      default: {fn} = {zero};", "    endcase",
+              f"    {fn} = {w}'(reg_word(code, DataW'(a), DataW'(b), DataW'(c)));",
               "  endfunction"]
     o += ["  // One instruction as the y-processor and the controller store it: {identifier, data}.",
           "  localparam int unsigned RecW = IdW + DataW;",
@@ -244,6 +253,9 @@ def gen_sv(spec: dict) -> str:
           "    logic        h_pol, v_pol;  // 1 = active-high sync pulse",
           "  } video_mode_t;",
           f"  localparam logic [1:0] VideoModeTest = 2'd{spec['video']['test']['index']};",
+          "  // The test mode's default geometry (the Test* parameters of the tops).",
+          "  localparam video_mode_t VideoTestDefault = "
+          + sv_mode(spec["video"]["test"]).replace("\n" + " " * 25, "\n" + " " * 44) + ";",
           "",
           "  // The fixed modes by index; the test mode (and any other index) returns mode 0,",
           "  // its geometry comes from de_video_timing's parameters.",

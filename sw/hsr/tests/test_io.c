@@ -25,6 +25,17 @@ static hsr_scene *cube_scene(const char *extra)
     return sc;
 }
 
+/* The cube scene (extra appended to its material) through HSR: 0 when a step fails. */
+static int cube_built(const char *extra, hsr_scene **sc, hsr_ctx **h, double **shade)
+{
+    *sc = cube_scene(extra);
+    *h = NULL;
+    *shade = NULL;
+    CHECK(*sc && hsr_scene_build(*sc, h, shade) == HSR_OK);
+    if (!*h) { hsr_scene_free(*sc); return 0; }
+    return 1;
+}
+
 static void test_obj_faces_slashes_negative_indices(void)
 {
     hsr_scene *sc = cube_scene("");
@@ -68,11 +79,10 @@ static void test_malformed_input_errors_name_file_and_line(void)
 
 static void test_cube_scene_three_faces_visible(void)
 {
-    hsr_scene *sc = cube_scene("");
-    hsr_ctx *h = NULL;
-    double *shade = NULL;
-    CHECK(sc && hsr_scene_build(sc, &h, &shade) == HSR_OK);
-    if (!h) { hsr_scene_free(sc); return; }
+    hsr_scene *sc;
+    hsr_ctx *h;
+    double *shade;
+    if (!cube_built("", &sc, &h, &shade)) return;
     int vis = 0;
     for (int id = 0; id < 6; id++) vis += t_visible_area(h, id) > 0;
     CHECK(vis == 3);
@@ -89,11 +99,10 @@ static void test_cube_scene_three_faces_visible(void)
 
 static void test_transparent_cube_shows_back_faces(void)
 {
-    hsr_scene *sc = cube_scene(" opacity 0.5");
-    hsr_ctx *h = NULL;
-    double *shade = NULL;
-    CHECK(sc && hsr_scene_build(sc, &h, &shade) == HSR_OK);
-    if (!h) { hsr_scene_free(sc); return; }
+    hsr_scene *sc;
+    hsr_ctx *h;
+    double *shade;
+    if (!cube_built(" opacity 0.5", &sc, &h, &shade)) return;
     int maxdepth = 0;
     for (int s = 0; s < hsr_llr_slots(h); s++) {
         int nv;

@@ -58,6 +58,16 @@ static int add_rect(typ *t, double l, double b, double r, double tp, double z)
     return add_poly(t, p, 4, z, 1);
 }
 
+/* The case most tests start from: one flat face of value v covering the rectangle
+ * (l, b)-(r, tp) on a W x H screen with background bg, scanned. 1 when every step worked. */
+static int scan_one_rect(typ *t, int W, int H, double bg, double v,
+                         double l, double b, double r, double tp)
+{
+    if (!setup(t, W, H, 1, NULL, YP_FLAT, bg)) return 0;
+    set_flat(t, 0, v);
+    return add_rect(t, l, b, r, tp, 1) == 0 && yp_scan(t->sh, t->h, &t->o, 0, H, t->fr) == HSR_OK;
+}
+
 static void pixels(typ *t, int y, int c, uint16_t *pix)
 {
     yp_simulate_line(&t->fr->line[c * t->fr->height + y], t->fr->width, pix);
@@ -73,10 +83,7 @@ static int count_op(const yp_cmdlist *l, int op)
 static void test_yp_span_of_one_pixel(void)
 {
     typ t;
-    CHECK(setup(&t, 16, 8, 1, NULL, YP_FLAT, 0.0));
-    set_flat(&t, 0, 1000);
-    CHECK(add_rect(&t, 10, 5, 11, 6, 1) == 0);
-    CHECK(yp_scan(t.sh, t.h, &t.o, 0, 8, t.fr) == HSR_OK);
+    CHECK(scan_one_rect(&t, 16, 8, 0.0, 1000, 10, 5, 11, 6));
     uint16_t pix[16];
     pixels(&t, 5, 0, pix);
     for (int x = 0; x < 16; x++) CHECK(pix[x] == (x == 10 ? 1000 : 0));
@@ -112,10 +119,8 @@ static void test_yp_domain_touching_screen_edges(void)
 static void test_yp_sliver_thinner_than_a_pixel(void)
 {
     typ t;
-    CHECK(setup(&t, 16, 8, 1, NULL, YP_FLAT, 0.0));
-    set_flat(&t, 0, 4000);
-    add_rect(&t, 5.25, 1, 5.5, 7, 1);        /* 1/4 pixel wide, no pixel centre inside */
-    CHECK(yp_scan(t.sh, t.h, &t.o, 0, 8, t.fr) == HSR_OK);
+    /* 1/4 pixel wide, no pixel centre inside */
+    CHECK(scan_one_rect(&t, 16, 8, 0.0, 4000, 5.25, 1, 5.5, 7));
     uint16_t pix[16];
     pixels(&t, 3, 0, pix);
     CHECK(pix[5] == 1000 && pix[4] == 0 && pix[6] == 0);
@@ -160,10 +165,7 @@ static void test_yp_pixel_shared_by_three_domains_sums_to_full_area(void)
 static void test_yp_horizontal_edges_partial_rows(void)
 {
     typ t;
-    CHECK(setup(&t, 16, 8, 1, NULL, YP_FLAT, 0.0));
-    set_flat(&t, 0, 4000);
-    add_rect(&t, 2, 2.25, 9, 4.75, 1);
-    CHECK(yp_scan(t.sh, t.h, &t.o, 0, 8, t.fr) == HSR_OK);
+    CHECK(scan_one_rect(&t, 16, 8, 0.0, 4000, 2, 2.25, 9, 4.75));
     uint16_t p2[16], p3[16], p4[16], p5[16];
     pixels(&t, 2, 0, p2); pixels(&t, 3, 0, p3); pixels(&t, 4, 0, p4); pixels(&t, 5, 0, p5);
     for (int x = 2; x < 9; x++) { CHECK(p2[x] == 3000); CHECK(p3[x] == 4000); CHECK(p4[x] == 3000); CHECK(p5[x] == 0); }
@@ -341,10 +343,7 @@ static void test_yp_scene_exceeding_intensity_is_rejected(void)
 static void test_yp_de48_stream_layout(void)
 {
     typ t;
-    CHECK(setup(&t, 16, 3, 1, NULL, YP_FLAT, 0.25));
-    set_flat(&t, 0, 1000);
-    add_rect(&t, 1, 0, 5, 3, 1);
-    CHECK(yp_scan(t.sh, t.h, &t.o, 0, 3, t.fr) == HSR_OK);
+    CHECK(scan_one_rect(&t, 16, 3, 0.25, 1000, 1, 0, 5, 3));
     const char *p = "build/t_yp.de48";
     CHECK(yp_write_de48(t.fr, 0, p) == HSR_OK);
     FILE *f = fopen(p, "rb");
