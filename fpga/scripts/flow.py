@@ -174,11 +174,11 @@ def fmax_of(rep: dict | None) -> float | None:
 def nobypass_chip(out: Path) -> Path:
     """What-if copy of de_chip.sv with the bus bypass muxes tied off (PE always used)."""
     src = (ROOT / "rtl/array/de_chip.sv").read_text()
-    new = src.replace("assign bus_id[i+1]   = byp_q[i] ? byp_id_q   : pe_id;",
+    new = src.replace("assign bus_id[i+1]   = byp_id_q | pe_id;",
                       "assign bus_id[i+1]   = pe_id;")
-    new = new.replace("assign bus_data[i+1] = byp_q[i] ? byp_data_q :\n",
-                      "assign bus_data[i+1] = 1'b0 ? byp_data_q :\n")
-    if new.count("byp_q[i] ? byp_id_q") + new.count("byp_q[i] ? byp_data_q") != 0 or new == src:
+    new = new.replace("assign bus_data[i+1] = byp_data_q | (",
+                      "assign bus_data[i+1] = (")
+    if new.count("byp_id_q | pe_id") + new.count("byp_data_q | (") != 0 or new == src:
         sys.exit("nobypass what-if: de_chip.sv bypass lines changed; update flow.py")
     out.mkdir(parents=True, exist_ok=True)
     path = out / "de_chip_nobypass.sv"

@@ -10,8 +10,9 @@
 // Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
 // PE's place is taken by a register on the bus and on the pixel chain (the source's
 // bypass is a wire; registered here so that the chip's clock does not depend on how many
-// PEs are bypassed in a row) and its pixel output is masked; relative addressing makes
-// the remaining PEs a smaller array, one clock later per bypassed PE.
+// PEs are bypassed in a row) and the PE is held in reset (no pixel, zero outputs, an
+// all-zero observation word); relative addressing makes the remaining PEs a smaller
+// array, one clock later per bypassed PE.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
 // (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
 `default_nettype none
@@ -151,8 +152,14 @@ module de_chip_core
     logic [DbgW-1:0]  pe_dbg;
     /* verilator lint_on UNUSEDSIGNAL */
 
+    // A bypassed PE is held in reset: its outputs are then zero, so the chain can OR
+    // them with the bypass register (below) instead of muxing with a select bit.
+    logic pe_rst;
+    assign pe_rst = rst_i || byp_q[i];
+
     de_pe #(.CarryBug(CarryBug)) u_pe (
-      .clk_i, .rst_i,
+      .clk_i,
+      .rst_i      (pe_rst),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .id_o       (pe_id),
@@ -164,15 +171,18 @@ module de_chip_core
 
     // A bypassed PE is a register (registered bypass): the bus takes one clock per PE
     // whatever the configuration, so no combinational path runs through two PEs. The
-    // pixel chain takes a register there too, so the pixels of the PEs in front catch up
-    // with the bus: pixels stay in raster order with no gap, one clock later per bypassed
-    // PE (docs/array.md). A faulty PE (test parameter) garbles what it passes on.
+    // bypass register holds zero while its PE is in use, and the PE's outputs are zero
+    // while it is bypassed (held in reset), so the next PE sees their OR: no select bit
+    // on the bus path. The pixel chain takes a register there too, so the pixels of the
+    // PEs in front catch up with the bus: pixels stay in raster order with no gap, one
+    // clock later per bypassed PE (docs/array.md). A faulty PE (test parameter) garbles
+    // what it passes on while it is in use.
     logic [IdW-1:0]   byp_id_q;
     logic [DataW-1:0] byp_data_q;
     logic             byp_pixv_q;
     logic [PixW-1:0]  byp_pix_q;
     always_ff @(posedge clk_i) begin
-      if (rst_i) begin
+      if (rst_i || !byp_q[i]) begin
         byp_id_q   <= '0;
         byp_data_q <= '0;
         byp_pixv_q <= 1'b0;
@@ -184,9 +194,8 @@ module de_chip_core
         byp_pix_q  <= pix_or[i];
       end
     end
-    assign bus_id[i+1]   = byp_q[i] ? byp_id_q   : pe_id;
-    assign bus_data[i+1] = byp_q[i] ? byp_data_q :
-                           (FaultMask[i] ? ~pe_data : pe_data);
+    assign bus_id[i+1]   = byp_id_q | pe_id;
+    assign bus_data[i+1] = byp_data_q | ((FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data);
     // At most one PE of the whole array drives a pixel in a cycle, so OR is a mux.
     assign pix_or[i+1]  = byp_q[i] ? byp_pix_q  : pix_or[i]  | (pe_pixv ? pe_pix : '0);
     assign pixv_or[i+1] = byp_q[i] ? byp_pixv_q : pixv_or[i] | pe_pixv;
