@@ -495,7 +495,8 @@ def seed_clock(name: str) -> str:
     for key in ("shift", "core", "pix"):
         if key in name:
             return "pixel" if key == "pix" else key
-    return "clk" if name.startswith("clk_i") else name.replace("$glbnet$", "")
+    name = name.replace("$glbnet$", "")
+    return "clk" if name.startswith("clk_i") else name
 
 
 def seeds_report(args, seed_list, need, per_seed, factor, floor) -> dict:
