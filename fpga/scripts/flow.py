@@ -544,7 +544,9 @@ def seeds_text(rep: dict) -> str:
     for s in rep["seeds"]:
         cp = rep["per_seed"][s]["critical_path"]
         if cp:
-            L.append(f"seed {s} ({rep['per_seed'][s]['seconds']} s): worst path {cp['total_ns']} ns "
+            secs = rep["per_seed"][s]["seconds"]
+            L.append(f"seed {s} ({f'{secs} s' if secs else 'the bitstream build'}): "
+                     f"worst path {cp['total_ns']} ns "
                      f"= {cp['logic_ns']} logic + {cp['routing_ns']} routing, "
                      f"{cp['from']} -> {cp['to']}")
     L += ["", f"Seed check: {'PASS' if rep['pass'] else 'FAIL'}"]
