@@ -8,8 +8,11 @@
 // gap and no collision (docs/array.md derives it).
 //
 // Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
-// PE passes the bus straight through (no register, so it adds no latency) and its pixel
-// output is masked; relative addressing makes the remaining PEs a smaller array.
+// PE's place is taken by a register on the bus and on the pixel chain (the source's
+// bypass is a wire; registered here so that the chip's clock does not depend on how many
+// PEs are bypassed in a row) and the PE is held in reset (no pixel, zero outputs, an
+// all-zero observation word); relative addressing makes the remaining PEs a smaller
+// array, one clock later per bypassed PE.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
 // (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
 `default_nettype none
@@ -84,7 +87,9 @@ module de_chip
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
-// pass through bypass muxes and OR gates only (the PEs' own outputs are registered).
+// pass through bypass muxes and OR gates only (the PEs' own outputs and the bypass
+// registers are registered); the bus path crosses one mux, the pixel chain the OR gates
+// of the PEs in use since the last bypass register.
 /* verilator lint_off DECLFILENAME */
 module de_chip_core
   import de_pkg::*;
@@ -147,8 +152,14 @@ module de_chip_core
     logic [DbgW-1:0]  pe_dbg;
     /* verilator lint_on UNUSEDSIGNAL */
 
+    // A bypassed PE is held in reset: its outputs are then zero, so the chain can OR
+    // them with the bypass register (below) instead of muxing with a select bit.
+    logic pe_rst;
+    assign pe_rst = rst_i || byp_q[i];
+
     de_pe #(.CarryBug(CarryBug)) u_pe (
-      .clk_i, .rst_i,
+      .clk_i,
+      .rst_i      (pe_rst),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .id_o       (pe_id),
@@ -158,13 +169,36 @@ module de_chip_core
       .dbg_o      (pe_dbg)
     );
 
-    // A bypassed PE is a wire; a faulty one (test parameter) garbles what it passes on.
-    assign bus_id[i+1]   = byp_q[i] ? bus_id[i]   : pe_id;
-    assign bus_data[i+1] = byp_q[i] ? bus_data[i] :
-                           (FaultMask[i] ? ~pe_data : pe_data);
+    // A bypassed PE is a register (registered bypass): the bus takes one clock per PE
+    // whatever the configuration, so no combinational path runs through two PEs. The
+    // bypass register holds zero while its PE is in use, and the PE's outputs are zero
+    // while it is bypassed (held in reset), so the next PE sees their OR: no select bit
+    // on the bus path. The pixel chain takes a register there too, so the pixels of the
+    // PEs in front catch up with the bus: pixels stay in raster order with no gap, one
+    // clock later per bypassed PE (docs/array.md). A faulty PE (test parameter) garbles
+    // what it passes on while it is in use.
+    logic [IdW-1:0]   byp_id_q;
+    logic [DataW-1:0] byp_data_q;
+    logic             byp_pixv_q;
+    logic [PixW-1:0]  byp_pix_q;
+    always_ff @(posedge clk_i) begin
+      if (rst_i || !byp_q[i]) begin
+        byp_id_q   <= '0;
+        byp_data_q <= '0;
+        byp_pixv_q <= 1'b0;
+        byp_pix_q  <= '0;
+      end else begin
+        byp_id_q   <= bus_id[i];
+        byp_data_q <= bus_data[i];
+        byp_pixv_q <= pixv_or[i];
+        byp_pix_q  <= pix_or[i];
+      end
+    end
+    assign bus_id[i+1]   = byp_id_q | pe_id;
+    assign bus_data[i+1] = byp_data_q | ((FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data);
     // At most one PE of the whole array drives a pixel in a cycle, so OR is a mux.
-    assign pix_or[i+1]  = pix_or[i]  | ((pe_pixv && !byp_q[i]) ? pe_pix : '0);
-    assign pixv_or[i+1] = pixv_or[i] | (pe_pixv && !byp_q[i]);
+    assign pix_or[i+1]  = byp_q[i] ? byp_pix_q  : pix_or[i]  | (pe_pixv ? pe_pix : '0);
+    assign pixv_or[i+1] = byp_q[i] ? byp_pixv_q : pixv_or[i] | pe_pixv;
     assign coll[i]      = pixv_or[i] && pe_pixv && !byp_q[i];
     assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgPaLsb:DbgId1Lsb], pe_dbg[DbgAccc3Lsb +: DbgCtlW]};
   end

@@ -1,11 +1,19 @@
 // Dual-clock FIFO: Gray-coded pointers, each synchronised into the other clock domain
-// through two flip-flops, storage in distributed RAM written in the write domain.
+// through two flip-flops, storage in block RAM written in the write domain and read
+// synchronously in the read domain into an output register (first word fall-through).
 //
-// The read side sees a word only after its write pointer has crossed (2-3 read clocks
+// The read side fetches a word only after its write pointer has crossed (2-3 read clocks
 // after the write), and the memory cell was written before the pointer moved, so the
-// asynchronous read is stable. Full and empty are conservative (a pointer seen late
-// only delays a write or a read). Reset: each side has its own synchronous reset; both
-// must be held together for a few clocks of the slower domain.
+// read is stable. Full and empty are conservative (a pointer seen late only delays a
+// write or a read). One word more than 2^AW can be held: the output register.
+// Reset: each side has its own synchronous reset; both must be held together for a few
+// clocks of the slower domain.
+//
+// Why block RAM with a read register (docs/fpga.md 3.5): with 2^AW = 256 words of
+// distributed RAM and an asynchronous read, the read pointer fanned out to every RAM
+// cell and its 16:1 read mux, which spread the read-pointer logic over the die; on the
+// ULX3S board that was the core clock's worst path (routing, 64-73 MHz over seeds
+// against 78.125). Here the pointer drives the address of two block RAMs only.
 `default_nettype none
 
 module de_afifo #(
@@ -31,8 +39,7 @@ module de_afifo #(
     return b ^ (b >> 1);
   endfunction
 
-  // Asynchronous read: distributed RAM (a block RAM would need a read register).
-  (* ram_style = "distributed" *) logic [W-1:0] mem [1 << AW];
+  (* ram_style = "block" *) logic [W-1:0] mem [1 << AW];
   logic [AW:0] wgray_q, rgray_q;            // each side's pointer, Gray-coded
 
   // ---- write domain ----
@@ -65,10 +72,23 @@ module de_afifo #(
   end
 
   // ---- read domain ----
+  // rbin_q: the next word to fetch into the output register (rdata_q, ovalid_q). A word
+  // is fetched when the memory holds one and the register is empty or being taken.
   logic [AW:0] rbin_d, rbin_q, wgray_r1_q, wgray_r2_q;
-  assign rvalid_o = (rgray_q != wgray_r2_q);
-  assign rdata_o  = mem[rbin_q[AW-1:0]];
-  assign rbin_d   = rbin_q + (AW + 1)'(rvalid_o && rready_i);
+  logic        nonempty, ren, ovalid_d, ovalid_q;
+  logic [W-1:0] rdata_q;
+  assign nonempty = (rgray_q != wgray_r2_q);
+  assign ren      = nonempty && (!ovalid_q || rready_i);
+  assign rbin_d   = rbin_q + (AW + 1)'(ren);
+  assign ovalid_d = ren || (ovalid_q && !rready_i);
+  assign rvalid_o = ovalid_q;
+  assign rdata_o  = rdata_q;
+
+  always_ff @(posedge rclk_i) begin
+    if (ren) begin
+      rdata_q <= mem[rbin_q[AW-1:0]];
+    end
+  end
 
   always_ff @(posedge rclk_i) begin
     if (rrst_i) begin
@@ -76,11 +96,13 @@ module de_afifo #(
       rgray_q    <= '0;
       wgray_r1_q <= '0;
       wgray_r2_q <= '0;
+      ovalid_q   <= 1'b0;
     end else begin
       rbin_q     <= rbin_d;
       rgray_q    <= bin2gray(rbin_d);
       wgray_r1_q <= wgray_q;
       wgray_r2_q <= wgray_r1_q;
+      ovalid_q   <= ovalid_d;
     end
   end
 endmodule
