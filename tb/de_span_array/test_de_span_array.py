@@ -365,7 +365,8 @@ async def stream_file(dut):
         await FallingEdge(dut.clk_i)
     t0 = b.cycle
     res = {"stream": str(path), "columns": b.n, "max_slots": int(dut.MaxSlots.value),
-           "forward": int(dut.Forward.value), "prefetch": int(dut.Prefetch.value)}
+           "forward": int(dut.Forward.value), "prefetch": int(dut.Prefetch.value),
+           "pass_aw": int(dut.PassAw.value)}
     if rate:
         # Paced like the display's bus: HTotal slots per line, one per `rate` clocks.
         htotal = int(os.environ.get("DE_SPAN_HTOTAL", 800))
@@ -403,10 +404,12 @@ async def stream_file(dut):
 # pass with forwarding alone.
 RUNS = [(37, 4, 0, 1, 1), (37, 2, 1, 1, 1), (130, 9, 0, 1, 1), (37, 4, 0, 0, 0),
         (37, 1, 0, 1, 0)]
+EXTRA = {}
 if os.environ.get("DE_SPAN_STREAM"):   # diffengine bench span: one full-width build
     RUNS = [(int(os.environ.get("DE_SPAN_COLS", 648)),
              int(os.environ.get("DE_SPAN_SLOTS", 4)), 0,
              int(os.environ.get("DE_SPAN_FWD", 1)), int(os.environ.get("DE_SPAN_PF", 1)))]
+    EXTRA = {"PassAw": int(os.environ.get("DE_SPAN_PASSAW", 5))}
 
 
 @pytest.mark.parametrize("cols,slots,bug,fwd,pf", RUNS,
@@ -417,6 +420,6 @@ def test_de_span_array(cols, slots, bug, fwd, pf):
     build_and_test(here, "de_span_array", rtl_files("span_array", "sim"),
                    "test_de_span_array",
                    parameters={"NumCols": cols, "MaxSlots": slots, "CarryBug": bug,
-                               "Forward": fwd, "Prefetch": pf},
+                               "Forward": fwd, "Prefetch": pf, **EXTRA},
                    extra_env={"DE_CARRY_BUG": str(bug)},
                    testcase="stream_file" if os.environ.get("DE_SPAN_STREAM") else None)

@@ -13,7 +13,8 @@ BENCHES = [
      "against triangle count"),
     ("hsr", ".hsr", "hidden-surface removal: Table 5.2, Fig. 5.30, incremental move"),
     ("array", ".array", "Verilated array speed (1/8/72 chips) against the baseline revision"),
-    ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames"),
+    ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames, "
+     "and the levers against the line budget"),
     ("recon", ".recon", "image reconstruction report -> docs/reconstruction.md"),
     ("recon-images", ".recon_images", "the reconstruction test images -> sw/images"),
     ("render", ".render", "docs/performance.md sections from docs/bench/*.json"),
