@@ -55,6 +55,7 @@ RTL_LEVERS = [
     ("Prefetch alone", 0, 1, 4, 0),
     ("Forward alone", 1, 0, 4, 0),
     ("Forward + Prefetch", 1, 1, 4, 0),
+    ("Forward + Prefetch + 128-entry pass table (PassAw = 7)", 1, 1, 7, 0),
 ]
 BUDGET_90 = 0.9
 
@@ -142,17 +143,24 @@ def measure_levers(scene: str, path: Path, now: dict, ratio: int) -> dict:
     def model(**kw):
         return span_timing.simulate(slots, **kw)
 
+    def paced(**kw):
+        """The model paced like the bus: the largest lag and backlog."""
+        st: dict = {}
+        span_timing.simulate(slots, rate=ratio, stats=st, **kw)
+        return {"model_lag": max(st["lag"]), "model_backlog": st["backlog"]}
+
     for lever in RTL_LEVERS + [NOW]:
         name, fwd, pf, aw, gap = lever
         log(f"{scene} r, levers: {name}")
         r = now if lever is NOW else run_stream(path, path.with_suffix(f".{fwd}{pf}{aw}{gap}.json"),
                                                 0, lever)
         c = r["clocks_per_line"]
-        m = model(gap=gap, prefetch=bool(pf), fwd="rtl" if fwd else "none", table=1 << aw)
+        kw = dict(prefetch=bool(pf), fwd="rtl" if fwd else "none", table=1 << aw)
+        m = model(gap=gap, **kw)
         # Line 0 also holds the reset sweep and the first slots' way in: left out.
         err = max(abs(x - y) for x, y in zip(c[1:], m[1:]))
         out["rtl"].append({"name": name, **summary(c, ratio), "model_max": max(m),
-                           "model_err": err,
+                           "model_err": err, **paced(**kw),
                            "wall_s": 0 if lever is NOW else r["wall_s"]})
         log(f"  RTL mean {sum(c) / len(c):.0f} max {max(c)}; model max {max(m)}, "
             f"|model - RTL| <= {err} clocks per line")
@@ -164,7 +172,7 @@ def measure_levers(scene: str, path: Path, now: dict, ratio: int) -> dict:
             ("2 engines per colour (+ Forward, Prefetch, 32 entries)", dict(best, engines=2)),
             ("3 engines per colour (+ Forward, Prefetch, 32 entries)", dict(best, engines=3))]:
         m = model(**kw)
-        out["model"].append({"name": name, **summary(m, ratio)})
+        out["model"].append({"name": name, **summary(m, ratio), **paced(**kw)})
     return out
 
 
@@ -179,7 +187,9 @@ def render_levers(data: dict) -> str:
     lines = [f"| lever | from | {head} |", "|---|---|" + "---|" * len(levs)]
 
     def cells(rs):
-        return " | ".join(f"{r['mean']:,.0f} / {r['max']:,}, **{r['pct']:.1f} %**" for r in rs)
+        return " | ".join(f"{r['mean']:,.0f} / {r['max']:,}, **{r['pct']:.1f} %**"
+                          + (f"; paced: lag {r['model_lag']:,}, backlog {r['model_backlog']}"
+                             if "model_lag" in r else "") for r in rs)
 
     for i, r0 in enumerate(levs[0]["rtl"]):
         rs = [lv["rtl"][i] for lv in levs]
@@ -194,10 +204,15 @@ def render_levers(data: dict) -> str:
                      f"line), the RTL now | budget | " + " | ".join(
                          f"{lv['rtl'][-1]['max']:,} of {b:,.0f}, **{100 * lv['rtl'][-1]['max'] / b:.0f} %**"
                          for lv in levs) + " |")
-    ok = all(lv["rtl"][-1]["pct"] <= 100 * BUDGET_90 for lv in levs)
-    verdict = ("The RTL now keeps the worst line of every scene here within 90 % of the line "
-               "budget." if ok else "The RTL now does NOT keep every scene's worst line "
-               "within 90 % of the line budget.")
+    # The verdict over every colour of the main table (the lever rows are the red stream).
+    worst = {}
+    for r in data["rows"]:
+        worst[r["scene"]] = max(worst.get(r["scene"], 0), max(r["free"]["clocks_per_line"]))
+    ok = all(w <= BUDGET_90 * budget for w in worst.values())
+    each = ", ".join(f"{sc} {w:,} ({100 * w / budget:.1f} %)" for sc, w in worst.items())
+    verdict = (f"Worst line over all three colours, the RTL now: {each}. "
+               + ("Every frame here stays within 90 % of the line budget." if ok else
+                  "NOT every frame here stays within 90 % of the line budget."))
     return "\n".join(lines) + "\n\n" + verdict + "\n"
 
 
@@ -300,6 +315,11 @@ per pass). A 32-entry pass table lets the front end run further ahead behind a l
 pass. More engines per colour (disjoint column ranges, each with its own state banks and
 pipeline) and an ideal bypass are estimates; the core clock rows divide the RTL's worst
 line by a longer line period: 78.125 MHz is the board's PLL output (pixel clock 25.0 MHz).
+*Paced* figures in the lever table (where given) are the model's, paced like the bus: the
+largest lag (clocks from a Refresh's due time to its line's last pixel; ~661 is the
+drain alone) and the largest backlog of slots (de_span_video's FIFO holds 256). The
+worst line unpaced is not the whole story: a pass table that fills up behind long passes
+stops the front end, and the bus's slots then wait in the display FIFO.
 
 {render_levers(rec['data'])}
 """

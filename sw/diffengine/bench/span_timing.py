@@ -40,28 +40,51 @@ def passes_of(slots, ncols: int = 648, max_slots: int = K_DEFAULT) -> list[list[
     return lines[:-1]
 
 
-def _front_end(slots, ncols: int, k: int, gap: int):
+def _paced(slots, htotal: int):
+    """Each line padded with Nops to `htotal` slots before its Refresh (the display's bus)."""
+    line = []
+    for sl in slots:
+        if sl[0] == isa.REFRESH:
+            yield from line
+            yield from [(isa.NOP, 0)] * (htotal - 1 - len(line))
+            yield sl
+            line = []
+        else:
+            line.append(sl)
+
+
+def _front_end(slots, ncols: int, k: int, gap: int, room=None, rate: int = 0,
+               htotal: int = 800, stats: dict | None = None):
     """The passes in stream order with the clock each is written into the pass table
     (commit; a Refresh is written when it is taken) and the index of its line. The front
     end takes a slot a clock (plus `gap` idle clocks of the driver after each) and
-    spends a clock on each commit of a pending group (the slot that closes it waits)."""
-    out = []                 # (pass, clock, line)
-    t, line = 0, 0
+    spends a clock on each commit of a pending group (the slot that closes it waits).
+    room(i): the first clock pass i finds a free table entry. rate: slot j of the padded
+    stream is due at clock j * rate (paced like the bus; a slot not taken when due waits,
+    and waiting slots go in back to back); stats gets the largest backlog in slots and
+    the clock each Refresh was due."""
+    t, line, n = 0, 0, 0
     open_, pend_cols, nslot, eff = False, None, 0, 0
+    stats = stats if stats is not None else {}
+    stats.update(backlog=0, due=[])
 
-    def commit():
-        nonlocal t, nslot, eff
-        out.append([Pass(False, pend_cols, nslot), t, line])
-        t += 1
-        nslot, eff = 0, 0
+    def at_room(c):
+        return max(c, room(n)) if room else c
 
-    for ident, data in slots:
+    src = _paced(slots, htotal) if rate else slots
+    for j, (ident, data) in enumerate(src):
+        due = j * rate
+        t = max(t, due)
         addr = bool(ident & isa.ID_ADDR)
         ref = bool(ident & isa.ID_REFRESH) and not addr
         is_dat = not addr and not ref and bool(ident & (isa.ID_DATA | isa.ID_ACC))
         pending = open_ and (nslot or eff)
         if pending and (not is_dat or nslot == k):
-            commit()
+            t = at_room(t)
+            yield Pass(False, pend_cols, nslot), t, line
+            n += 1
+            t += 1
+            nslot, eff = 0, 0
         if is_dat:
             nslot += int(open_)
         else:
@@ -75,15 +98,20 @@ def _front_end(slots, ncols: int, k: int, gap: int):
                     pend_cols = list(range(b0, min(b0 + b1, ncols)))
                 open_, nslot, eff = True, 0, int(sub in (isa.SUB_EVAL0, isa.SUB_DIS))
             elif ref:
-                out.append([Pass(True, [], 0), t, line])
+                t = at_room(t)
+                stats["due"].append(due)
+                yield Pass(True, [], 0), t, line
+                n += 1
                 line += 1
+        if rate:
+            stats["backlog"] = max(stats["backlog"], t // rate - j)
         t += 1 + gap
-    return out
 
 
 def simulate(slots, ncols: int = 648, k: int = K_DEFAULT, *, gap: int = 0,
              prefetch: bool = False, fwd: str = "none", engines: int = 1,
-             table: int = NPASS) -> list[int]:
+             table: int = NPASS, rate: int = 0, htotal: int = 800,
+             stats: dict | None = None) -> list[int]:
     """Clocks per line (from one Refresh token's issue to the next) of de_span_array fed
     `slots` back to back (gap 0) or with `gap` idle clocks after each slot.
 
@@ -98,23 +126,21 @@ def simulate(slots, ncols: int = 648, k: int = K_DEFAULT, *, gap: int = 0,
     """
     dist = {"none": k + 4, "rtl": k + 1, "ideal": 1}[fwd]
     bounds = [ncols * e // engines for e in range(engines + 1)]
-    fe = _front_end(slots, ncols, k, gap)
+    retire = []                               # clock each pass leaves the table
+
+    def room(i):
+        # The table has room for pass i once pass i - (table - 1) has retired.
+        return retire[i - (table - 1)] + 1 if i >= table - 1 else 0
+
+    stats = stats if stats is not None else {}
+    fe = _front_end(slots, ncols, k, gap, room, rate, htotal, stats)
     last = [dict() for _ in range(engines)]   # column -> clock of its last token
     tok_free = [0] * engines                  # next clock each engine may issue a token
     fin = -1                                  # clock of the previous pass's last token
     xfer_prev = -1
     drain_free = 0
-    retire = []                               # clock each pass leaves the table
     refresh_at = []
-    shift = 0                                 # front-end delay from a full pass table
-    for i, (p, c_commit, _) in enumerate(fe):
-        c_commit += shift
-        if i >= table - 1:
-            # The table has room for pass i once pass i - (table - 1) has retired.
-            need = retire[i - (table - 1)] + 1
-            if c_commit < need:
-                shift += need - c_commit
-                c_commit = need
+    for p, c_commit, _ in fe:
         load = max(c_commit + 1, xfer_prev)              # decoded into nxt
         xfer = max(load + 1, fin if prefetch else fin + 1)
         xfer_prev = xfer
@@ -149,4 +175,7 @@ def simulate(slots, ncols: int = 648, k: int = K_DEFAULT, *, gap: int = 0,
                     ends.append(t - 1)
                 fin = max(ends)
         retire.append(fin + k + 3)
+    # A line's last pixel leaves the drain ~NumCols + K + 6 clocks after its Refresh
+    # token; paced, the lag is counted from the clock the Refresh was due.
+    stats["lag"] = [r + ncols + k + 6 - d for r, d in zip(refresh_at, stats["due"])]
     return [b - a for a, b in zip([0] + refresh_at, refresh_at)]
