@@ -264,12 +264,12 @@ def render(rec: dict) -> str:
                     f"is out within the lag above of its Refresh. ")
     for sc in sorted({r["scene"] for r in bad}):
         rs = [r for r in bad if r["scene"] == sc]
-        verdict += (f"On {sc} a band of lines needs more than the line period: the array "
-                    f"falls up to {max(r['paced']['backlog_slots'] for r in rs)} slots behind "
-                    f"the bus and a line's last pixel comes up to "
-                    f"{max(max(r['paced']['lag_clocks']) for r in rs)} clocks after its "
-                    f"Refresh; a display path (de_span_video) then needs a FIFO that deep "
-                    f"and a Latency that long, or a faster core clock. ")
+        verdict += (f"On {sc}, paced, the array falls up to "
+                    f"{max(r['paced']['backlog_slots'] for r in rs)} slots behind the bus "
+                    f"(the pass table full behind long passes) and a line's last pixel comes "
+                    f"up to {max(max(r['paced']['lag_clocks']) for r in rs)} clocks after "
+                    f"its Refresh was due; a display path (de_span_video) needs a FIFO that "
+                    f"deep and a Latency that long. ")
     body = f"""{SECTION}
 
 Reproduce: `make bench-span` (`diffengine bench span --write`, {minutes:.0f} min on
