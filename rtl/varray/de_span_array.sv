@@ -135,6 +135,8 @@ module de_span_array
     logic [PixW-1:0] i12;
     logic          accm;
     logic [3:0]    nslot;
+    logic [CW-1:0] cend;       // the walk's end, worked out when the pass is written
+    logic          nul;        // the pass touches no column
   } hdr_t;
   hdr_t  hdr_mem [NPass];
   slot_t slot_q [K];                   // slot j of the pass in stage j+1 (registered)
@@ -180,9 +182,15 @@ module de_span_array
     hdr_w.i12   = i12_q;
     hdr_w.accm  = accm_q;
     hdr_w.nslot = nslot_q;
+    // The end of the walk and the empty pass, from the group's registers: the table read
+    // in front of the issue (the prefetch register) then does no arithmetic.
+    hdr_w.cend  = (per_q || CW'(x_q) + CW'(dx_q) >= CW'(NumCols)) ? CW'(NumCols)
+                                                                  : CW'(x_q) + CW'(dx_q);
+    hdr_w.nul   = (CW'(x_q) >= hdr_w.cend);
     if (ref_we) begin
       hdr_w       = '0;
       hdr_w.rfr   = 1'b1;
+      hdr_w.nul   = 1'b1;
     end
   end
 
@@ -308,17 +316,16 @@ module de_span_array
       end else if (hr.per) begin
         // Period dX; dX = 0 reloads the countdown with 4095: period 4096 (isa.md 5).
         ncol_d  = CW'(hr.x);
-        nend_d  = CW'(NumCols);
+        nend_d  = hr.cend;
         nstep_d = (hr.dx == '0) ? CW'(4096) : CW'(hr.dx);
       end else begin
         ncol_d  = CW'(hr.x);
-        nend_d  = (CW'(hr.x) + CW'(hr.dx) < CW'(NumCols)) ? CW'(hr.x) + CW'(hr.dx)
-                                                         : CW'(NumCols);
+        nend_d  = hr.cend;
         nstep_d = CW'(1);
       end
       // A pass that touches no column (and the Refresh token) issues one token that
       // only retires the table entry, so passes retire in order.
-      nxt_d.nul = (ncol_d >= nend_d);
+      nxt_d.nul = hr.nul;
     end
   end
 
