@@ -8,9 +8,9 @@
 //
 //   front end   collects a *group*: an address slot and the data/ACC slots behind it
 //               (they act exactly on the address slot's span, isa.md section 5), writes
-//               it into a 16-entry pass table; a group of more than MaxSlots slots is
-//               split into passes of MaxSlots (each slot is its own chain, so a split
-//               is exact).
+//               it into a pass table (2**PassAw entries); a group of more than
+//               MaxSlots slots is split into passes of MaxSlots (each slot is its own
+//               chain, so a split is exact).
 //   issue       walks a pass's columns (range: X..X+dX-1, periodic: X, X+dX, ...,
 //               clipped at NumCols), one token per clock, reading the column's state.
 //   stage 0     Eval0 / Dis of the address slot (after the RAM read and its register).
@@ -22,7 +22,12 @@
 //               column per clock, column cleared) while the next line runs.
 //
 // A token is not issued while its column is in flight (read, not yet written back), so
-// passes over overlapping spans see each other's results in stream order.
+// passes over overlapping spans see each other's results in stream order. Forward = 1
+// narrows that wait to the first K stages: the column's state is bypassed from write
+// back (or from the two clocks after it) to the next token's stage 0. Prefetch = 1 decodes
+// the next pass a clock ahead and starts it right behind the last token of the running
+// one (else a clock later). The levers' cost in clocks per line: docs/performance.md,
+// "Span-serial array: levers" (`make bench-span`).
 //
 // Interface: a valid/ready stream of unskewed slots in, a pixel stream out (NumCols
 // pixels per Refresh, in column order, with their column). Acc_mode is global state:
@@ -37,7 +42,10 @@ module de_span_array
 #(
   parameter int unsigned NumCols  = 648,  // virtual columns (x-processors)
   parameter int unsigned MaxSlots = 4,    // data/ACC slots per pass (4 = Eval3 in one)
-  parameter int unsigned CarryBug = 0
+  parameter int unsigned CarryBug = 0,
+  parameter int unsigned Forward  = 1,    // bypass write back to a column's next token
+  parameter int unsigned Prefetch = 1,    // next pass loaded as the last token issues
+  parameter int unsigned PassAw   = 5     // pass table: 2**PassAw entries
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
@@ -53,7 +61,7 @@ module de_span_array
   localparam int unsigned K    = MaxSlots;
   localparam int unsigned CW   = 13;                 // column counter: X + dX < 8192
   localparam int unsigned AW   = NumCols > 1 ? $clog2(NumCols) : 1;
-  localparam int unsigned PW   = 4;                  // pass table: 16 entries
+  localparam int unsigned PW   = PassAw;             // pass table: 2**PassAw entries
   localparam int unsigned NPass = 1 << PW;
   // Column state: A, B, C, D, pA, pB, pC, dis, lock.
   localparam int unsigned StW  = 4 * DataW + 5;
@@ -66,6 +74,9 @@ module de_span_array
   end
   if (CarryBug > 1) begin : g_bad_carry_bug
     $fatal(1, "de_span_array: CarryBug must be 0 or 1");
+  end
+  if (Forward > 1 || Prefetch > 1 || PassAw < 2 || PassAw > 8) begin : g_bad_levers
+    $fatal(1, "de_span_array: Forward and Prefetch must be 0 or 1, PassAw 2..8");
   end
 
   typedef struct packed {
@@ -124,14 +135,15 @@ module de_span_array
     logic [PixW-1:0] i12;
     logic          accm;
     logic [3:0]    nslot;
+    logic [CW-1:0] cend;       // the walk's end, worked out when the pass is written
+    logic          nul;        // the pass touches no column
   } hdr_t;
   hdr_t  hdr_mem [NPass];
   slot_t slot_q [K];                   // slot j of the pass in stage j+1 (registered)
 
   logic [PW:0] wr_cnt_d, wr_cnt_q, iss_cnt_d, iss_cnt_q, ret_cnt_d, ret_cnt_q;
-  logic [PW-1:0] wr_ptr, iss_ptr;
+  logic [PW-1:0] wr_ptr;
   assign wr_ptr  = wr_cnt_q[PW-1:0];
-  assign iss_ptr = iss_cnt_q[PW-1:0];
   // Entry wr_ptr is free while fewer than NPass passes are committed and not retired.
   // Registered, and counted as if the previous clock had committed a pass (one entry
   // is given up): the ready decision then needs no subtraction after the slot's decode.
@@ -170,9 +182,15 @@ module de_span_array
     hdr_w.i12   = i12_q;
     hdr_w.accm  = accm_q;
     hdr_w.nslot = nslot_q;
+    // The end of the walk and the empty pass, from the group's registers: the table read
+    // in front of the issue (the prefetch register) then does no arithmetic.
+    hdr_w.cend  = (per_q || CW'(x_q) + CW'(dx_q) >= CW'(NumCols)) ? CW'(NumCols)
+                                                                  : CW'(x_q) + CW'(dx_q);
+    hdr_w.nul   = (CW'(x_q) >= hdr_w.cend);
     if (ref_we) begin
       hdr_w       = '0;
       hdr_w.rfr   = 1'b1;
+      hdr_w.nul   = 1'b1;
     end
   end
 
@@ -248,10 +266,21 @@ module de_span_array
   tok_t          cur_d, cur_q;        // the running pass's token template
   tok_t          iss;                 // token issued this clock (vld = 0: none)
   logic          hazard;
+  // The next pass, decoded a clock ahead from the pass table (entry ld_cnt): its token
+  // template and column range. It goes into the issue registers when the engine is idle,
+  // or (Prefetch) in the clock the running pass issues its last token.
+  tok_t          nxt_d, nxt_q;
+  logic [CW-1:0] ncol_d, ncol_q, nend_d, nend_q, nstep_d, nstep_q;
+  logic          nvld_d, nvld_q, fin, xfer;
+  logic [PW:0]   ld_cnt_d, ld_cnt_q;
+  // With forwarding a token waits only while an earlier token of its column is in the
+  // first K stages: one further on reaches write back (or has passed it) by the time this
+  // one needs the column's state, and is bypassed to it (fsel, below).
+  localparam int unsigned HzStages = (Forward == 1) ? K : K + 3;
 
   always_comb begin
     hazard = 1'b0;
-    for (int s = 0; s < K + 3; s++) begin
+    for (int s = 0; s < HzStages; s++) begin
       if (tok_q[s].vld && !tok_q[s].nul && (tok_q[s].col == col_q)) begin
         hazard = 1'b1;
       end
@@ -259,7 +288,46 @@ module de_span_array
   end
 
   hdr_t hr;
-  assign hr = hdr_mem[iss_ptr];
+  assign hr = hdr_mem[ld_cnt_q[PW-1:0]];
+
+  // Decode the next pass: its column range and its token template.
+  always_comb begin
+    nxt_d    = nxt_q;
+    ncol_d   = ncol_q;
+    nend_d   = nend_q;
+    nstep_d  = nstep_q;
+    nvld_d   = nvld_q && !xfer;
+    ld_cnt_d = ld_cnt_q;
+    if ((!nvld_q || xfer) && (ld_cnt_q != wr_cnt_q)) begin
+      nvld_d      = 1'b1;
+      ld_cnt_d    = ld_cnt_q + 1'b1;
+      nxt_d       = '0;
+      nxt_d.first = 1'b1;
+      nxt_d.ptr   = ld_cnt_q[PW-1:0];
+      nxt_d.rfr   = hr.rfr;
+      nxt_d.eff   = hr.eff;
+      nxt_d.i12   = hr.i12;
+      nxt_d.accm  = hr.accm;
+      nxt_d.nslot = hr.nslot;
+      if (hr.rfr) begin
+        ncol_d  = '0;
+        nend_d  = '0;
+        nstep_d = CW'(1);
+      end else if (hr.per) begin
+        // Period dX; dX = 0 reloads the countdown with 4095: period 4096 (isa.md 5).
+        ncol_d  = CW'(hr.x);
+        nend_d  = hr.cend;
+        nstep_d = (hr.dx == '0) ? CW'(4096) : CW'(hr.dx);
+      end else begin
+        ncol_d  = CW'(hr.x);
+        nend_d  = hr.cend;
+        nstep_d = CW'(1);
+      end
+      // A pass that touches no column (and the Refresh token) issues one token that
+      // only retires the table entry, so passes retire in order.
+      nxt_d.nul = hr.nul;
+    end
+  end
 
   always_comb begin
     run_d     = run_q;
@@ -275,6 +343,7 @@ module de_span_array
     iss.col   = col_q;
     iss.bank  = bank_q;
     iss.last  = (col_q + step_q >= end_q);
+    fin       = 1'b0;
     if (scrub_q) begin
       // Reset sweep: clear every column (block RAM has no reset).
       iss.vld = 1'b1;
@@ -295,6 +364,7 @@ module de_span_array
         bank_d    = !bank_q;
         run_d     = 1'b0;
         iss_cnt_d = iss_cnt_q + 1'b1;
+        fin       = 1'b1;
       end
     end else if (run_q) begin
       if (cur_q.nul || !hazard) begin
@@ -305,37 +375,18 @@ module de_span_array
           iss.last  = 1'b1;
           run_d     = 1'b0;
           iss_cnt_d = iss_cnt_q + 1'b1;
+          fin       = 1'b1;
         end
       end
-    end else if (iss_cnt_q != wr_cnt_q) begin
-      // Load the next pass (one clock): its column range and its token template.
-      run_d       = 1'b1;
-      cur_d       = '0;
-      cur_d.first = 1'b1;
-      cur_d.ptr   = iss_ptr;
-      cur_d.rfr   = hr.rfr;
-      cur_d.eff   = hr.eff;
-      cur_d.i12   = hr.i12;
-      cur_d.accm  = hr.accm;
-      cur_d.nslot = hr.nslot;
-      if (hr.rfr) begin
-        col_d  = '0;
-        end_d  = '0;
-        step_d = CW'(1);
-      end else if (hr.per) begin
-        // Period dX; dX = 0 reloads the countdown with 4095: period 4096 (isa.md 5).
-        col_d  = CW'(hr.x);
-        end_d  = CW'(NumCols);
-        step_d = (hr.dx == '0) ? CW'(4096) : CW'(hr.dx);
-      end else begin
-        col_d  = CW'(hr.x);
-        end_d  = (CW'(hr.x) + CW'(hr.dx) < CW'(NumCols)) ? CW'(hr.x) + CW'(hr.dx)
-                                                        : CW'(NumCols);
-        step_d = CW'(1);
-      end
-      // A pass that touches no column (and the Refresh token) issues one token that
-      // only retires the table entry, so passes retire in order.
-      cur_d.nul = (col_d >= end_d);
+    end
+    // Take the next pass into the issue registers.
+    xfer = !scrub_q && nvld_q && (!run_q || ((Prefetch == 1) && fin));
+    if (xfer) begin
+      run_d  = 1'b1;
+      cur_d  = nxt_q;
+      col_d  = ncol_q;
+      end_d  = nend_q;
+      step_d = nstep_q;
     end
   end
 
@@ -346,7 +397,7 @@ module de_span_array
   logic [StW-1:0] ram1 [NumCols];
   // Block RAM output, registered once more (the DP16KD output register: its clock-to-out
   // without it was the critical path), then the bank mux.
-  st_t  rd0_q, rd1_q, rd0_q2, rd1_q2, rd_q;
+  st_t  rd0_q, rd1_q, rd0_q2, rd1_q2, rd_q, rdf;
   assign rd_q = tok_q[1].bank ? rd1_q2 : rd0_q2;
   st_t  st_q [1:K + 1];                // st_q[s]: state entering stage s
   logic [DataW-1:0] cv_d [1:K], cv_q [1:K];  // per stage: value out of the last column
@@ -364,14 +415,48 @@ module de_span_array
   assign dpix       = dbank_q ? rd1_q2.d[DataW-1 -: PixW] : rd0_q2.d[DataW-1 -: PixW];
   assign drain_busy = dpend_q || drun_q || dwr_q || dwr_q2;
 
+  // Forwarding. A token issued d >= K+1 clocks after an earlier one on its column (same
+  // bank) enters stage 0 when that one is in write back (d = K+1), or one or two clocks
+  // past it (its write not yet in what the block RAM read returned): the column's state
+  // then comes from there. Selected a clock ahead, when the token is in tok_q[0], so stage 0
+  // sees a registered select; the newest match wins.
+  logic          fw1_q, fwb1_q;   // write back a clock ago: valid, bank, column
+  logic [AW-1:0] fwc1_q;
+  st_t           fws1_q, fws2_q;
+  logic [1:0]    fsel_d, fsel_q;
+  always_comb begin
+    fsel_d = 2'd0;
+    if (Forward == 1 && tok_q[0].vld && !tok_q[0].nul) begin
+      if (fw1_q && fwb1_q == tok_q[0].bank && fwc1_q == AW'(tok_q[0].col)) begin
+        fsel_d = 2'd3;
+      end
+      if (tok_q[K + 2].vld && !tok_q[K + 2].nul && tok_q[K + 2].bank == tok_q[0].bank &&
+          tok_q[K + 2].col == tok_q[0].col) begin
+        fsel_d = 2'd2;
+      end
+      if (tok_q[K + 1].vld && !tok_q[K + 1].nul && tok_q[K + 1].bank == tok_q[0].bank &&
+          tok_q[K + 1].col == tok_q[0].col) begin
+        fsel_d = 2'd1;
+      end
+    end
+  end
+  always_comb begin
+    unique case (fsel_q)
+      2'd1:    rdf = st_q[K + 1];
+      2'd2:    rdf = fws1_q;
+      2'd3:    rdf = fws2_q;
+      default: rdf = rd_q;
+    endcase
+  end
+
   // Stage 0: the address slot's own effect and Refresh.
   always_comb begin
-    st_s[1] = rd_q;
+    st_s[1] = rdf;
     if (tok_q[1].vld && !tok_q[1].nul) begin
       if (tok_q[1].clr) begin
         st_s[1] = '0;
       end else if (tok_q[1].eff == EffEval0) begin
-        if (!rd_q.lock && !rd_q.dis) begin
+        if (!rdf.lock && !rdf.dis) begin
           st_s[1].d    = {tok_q[1].i12, 24'd0};
           st_s[1].lock = 1'b1;
         end
@@ -574,6 +659,14 @@ module de_span_array
       pixv_q    <= 1'b0;
       pix_q     <= '0;
       pixc_q    <= '0;
+      nvld_q    <= 1'b0;
+      ld_cnt_q  <= '0;
+      nxt_q     <= '0;
+      ncol_q    <= '0;
+      nend_q    <= '0;
+      nstep_q   <= '0;
+      fsel_q    <= 2'd0;
+      fw1_q     <= 1'b0;
       for (int s = 0; s < K + 3; s++) begin
         tok_q[s] <= '0;
       end
@@ -611,6 +704,14 @@ module de_span_array
       pixv_q    <= pixv_d;
       pix_q     <= pix_d;
       pixc_q    <= pixc_d;
+      nvld_q    <= nvld_d;
+      ld_cnt_q  <= ld_cnt_d;
+      nxt_q     <= nxt_d;
+      ncol_q    <= ncol_d;
+      nend_q    <= nend_d;
+      nstep_q   <= nstep_d;
+      fsel_q    <= fsel_d;
+      fw1_q     <= wb_we;
       tok_q[0]  <= iss;
       for (int s = 1; s < K + 3; s++) begin
         tok_q[s] <= tok_q[s - 1];
@@ -622,6 +723,10 @@ module de_span_array
   always_ff @(posedge clk_i) begin
     rd0_q2 <= rd0_q;
     rd1_q2 <= rd1_q;
+    fwb1_q <= wb_bank;
+    fwc1_q <= wb_col;
+    fws1_q <= st_q[K + 1];
+    fws2_q <= fws1_q;
     for (int s = 1; s <= K + 1; s++) begin
       st_q[s] <= st_s[s];
     end

@@ -71,11 +71,15 @@ class Bench:
                 break
         d.instr_valid_i.value = 0
 
-    async def play(self, slots):
-        """Offer each slot until the array takes it, with random idle clocks between."""
+    async def play(self, slots, gap: int = 0):
+        """Offer each slot until the array takes it, with random idle clocks between
+        (idle), and `gap` idle clocks after each slot; with neither, back to back."""
         d = self.dut
+        await FallingEdge(d.clk_i)
         for ident, data in slots:
-            await FallingEdge(d.clk_i)
+            for _ in range(gap):
+                d.instr_valid_i.value = 0
+                await FallingEdge(d.clk_i)
             while self.idle and self.rng.random() < self.idle:
                 d.instr_valid_i.value = 0
                 await FallingEdge(d.clk_i)
@@ -252,6 +256,62 @@ async def hazards_and_splits(dut):
 
 
 @cocotb.test()
+async def forwarding(dut):
+    """Passes on one column d clocks apart around the forwarding window (an earlier token
+    of the column in the first K stages holds the next one back; from write back on, or
+    one or two clocks past it, its state is bypassed to it): fillers of 0..K+5 columns
+    elsewhere between them, behind full-width passes that fill the pass table, every kind
+    of pass (Eval0, Dis, Eval0-Eval5 with splits, Set) and Refreshes among them (the bank
+    changes: nothing may be bypassed across one). Equal to the functional model. Then the
+    clocks per pass of one column over and over: at most max(K+1, the front end's) with
+    Forward, at least K+4 without (the column's whole trip through the pipeline)."""
+    b = await start(dut)
+    n, k, fwd = b.n, int(dut.MaxSlots.value), int(dut.Forward.value)
+    c, f0 = 3, 10
+    kinds = [lambda j: isa.Command("EVAL0", c, 1, (100 + j,)),
+             lambda j: isa.Command("DIS", c, 1),
+             lambda j: isa.Command("SETI", c, 1, (ONE // (j + 2),))]
+    kinds += [lambda j, m=m: isa.Command("EVAL", c, 1, tuple(
+        ((-1) ** i) * ((ONE // (3 + j % 5)) >> (2 * i)) for i in range(m))) for m in range(1, 7)]
+    cmds = []
+    for f in range(k + 6):
+        cmds += [isa.Command("EVAL", 0, n, (ONE // 2, ONE // 64, -ONE // 4096, ONE // 65536))] * 2
+        for j, kind in enumerate(kinds):
+            cmds.append(kind(j + f))
+            if f:
+                cmds.append(isa.Command("EVAL", f0, f, (ONE // 4, ONE // 128)))
+            if j == 4 and f % 3 == 1:
+                cmds.append(isa.Command("REFRESH"))
+        cmds.append(isa.Command("REFRESH"))
+    await b.play(isa.serialise(cmds))
+    await b.drain()
+    b.check(cmds, bug())
+
+    # Timing: one column, 48 times over, against the same stream without them.
+    from diffengine.bench import span_timing
+    lead = [isa.Command("EVAL", 0, n, (ONE // 2, ONE // 64))] * 2
+    same = [isa.Command("EVAL", 5, 1, (ONE // (j + 3),)) for j in range(48)]
+    clocks = []
+    for body in ([], same):
+        b.pixels.clear()
+        t0 = b.cycle
+        await b.play(isa.serialise(lead + body + [isa.Command("REFRESH")]))
+        await b.drain()
+        clocks.append(b.cycle - t0)
+    slots = isa.serialise(same)
+    passes = sum(len(ln) - 1 for ln in span_timing.passes_of(
+        slots + [(isa.REFRESH, 0)], n, k))
+    front = (len(slots) + passes) / passes      # a slot per clock, a clock per commit
+    rate = (clocks[1] - clocks[0]) / passes
+    dut._log.info(f"one column over and over: {rate:.2f} clocks per pass (K = {k}, "
+                  f"Forward = {fwd}, front end {front:.2f})")
+    if fwd:
+        assert rate <= max(k + 1, front) + 0.5, f"{rate:.2f} clocks per pass with forwarding"
+    else:
+        assert rate >= k + 4 - 0.5, f"{rate:.2f} clocks per pass without forwarding"
+
+
+@cocotb.test()
 async def reset_mid_stream(dut):
     """rst_i for one clock with passes in flight: the next line is a fresh array's."""
     b = await start(dut)
@@ -298,7 +358,9 @@ async def stream_file(dut):
     while int(dut.busy_o.value):          # the reset sweep
         await FallingEdge(dut.clk_i)
     t0 = b.cycle
-    res = {"stream": str(path), "columns": b.n, "max_slots": int(dut.MaxSlots.value)}
+    res = {"stream": str(path), "columns": b.n, "max_slots": int(dut.MaxSlots.value),
+           "forward": int(dut.Forward.value), "prefetch": int(dut.Prefetch.value),
+           "pass_aw": int(dut.PassAw.value)}
     if rate:
         # Paced like the display's bus: HTotal slots per line, one per `rate` clocks.
         htotal = int(os.environ.get("DE_SPAN_HTOTAL", 800))
@@ -310,8 +372,12 @@ async def stream_file(dut):
         msg = (f"paced at 1 slot / {rate} clocks: last pixel of a line at most {max(lag)} "
                f"clocks after its Refresh was due, backlog at most {backlog} slots")
     else:
-        await b.play(slots)
+        # Back to back, as a FIFO with a backlog hands slots over (DE_SPAN_GAP=1: the
+        # idle clock after every slot that this driver used to leave).
+        gap = int(os.environ.get("DE_SPAN_GAP", "0"))
+        await b.play(slots, gap)
         await b.drain()
+        res["gap"] = gap
         ends = [t0] + b.refresh_cycles
         per_line = [ends[i + 1] - ends[i] for i in range(len(ends) - 1)]
         res.update(clocks_per_line=per_line, clocks_total=b.cycle - t0)
@@ -325,22 +391,29 @@ async def stream_file(dut):
 
 
 # ---- pytest runners ---------------------------------------------------------------------
-# (columns, slots per pass, carry bug): 37 columns (odd, not a power of two) with a pass
-# per Eval3; 2 slots per pass splits every Eval into 2-5 passes, with the carry fault;
-# 130 columns take the figure lists whole.
-RUNS = [(37, 4, 0), (37, 2, 1), (130, 9, 0)]
+# (columns, slots per pass, carry bug, Forward, Prefetch): 37 columns (odd, not a power of
+# two) with a pass per Eval3; 2 slots per pass splits every Eval into 2-5 passes, with the
+# carry fault; 130 columns take the figure lists whole; the same 37 columns without
+# forwarding and prefetch (the hazard wait in full, a load clock per pass); 1 slot per
+# pass with forwarding alone.
+RUNS = [(37, 4, 0, 1, 1), (37, 2, 1, 1, 1), (130, 9, 0, 1, 1), (37, 4, 0, 0, 0),
+        (37, 1, 0, 1, 0)]
+EXTRA = {}
 if os.environ.get("DE_SPAN_STREAM"):   # diffengine bench span: one full-width build
     RUNS = [(int(os.environ.get("DE_SPAN_COLS", 648)),
-             int(os.environ.get("DE_SPAN_SLOTS", 4)), 0)]
+             int(os.environ.get("DE_SPAN_SLOTS", 4)), 0,
+             int(os.environ.get("DE_SPAN_FWD", 1)), int(os.environ.get("DE_SPAN_PF", 1)))]
+    EXTRA = {"PassAw": int(os.environ.get("DE_SPAN_PASSAW", 5))}
 
 
-@pytest.mark.parametrize("cols,slots,bug", RUNS,
-                         ids=[f"cols{c}_slots{s}_bug{b}" for c, s, b in RUNS])
-def test_de_span_array(cols, slots, bug):
+@pytest.mark.parametrize("cols,slots,bug,fwd,pf", RUNS,
+                         ids=[f"cols{c}_slots{s}_bug{b}_fwd{f}_pf{p}" for c, s, b, f, p in RUNS])
+def test_de_span_array(cols, slots, bug, fwd, pf):
     from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
     build_and_test(here, "de_span_array", rtl_files("span_array", "sim"),
                    "test_de_span_array",
-                   parameters={"NumCols": cols, "MaxSlots": slots, "CarryBug": bug},
+                   parameters={"NumCols": cols, "MaxSlots": slots, "CarryBug": bug,
+                               "Forward": fwd, "Prefetch": pf, **EXTRA},
                    extra_env={"DE_CARRY_BUG": str(bug)},
                    testcase="stream_file" if os.environ.get("DE_SPAN_STREAM") else None)

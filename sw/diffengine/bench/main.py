@@ -16,7 +16,8 @@ BENCHES = [
     ("hsr-incr", ".hsr_incr", "incremental HSR against a full build: teapot + box, 10-10,000 parts, "
      "the CAD drag, against --baseline-rev"),
     ("array", ".array", "Verilated array speed (1/8/72 chips) against the baseline revision"),
-    ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames"),
+    ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames, "
+     "and the levers against the line budget"),
     ("recon", ".recon", "image reconstruction report -> docs/reconstruction.md"),
     ("recon-images", ".recon_images", "the reconstruction test images -> sw/images"),
     ("viewer", ".viewer", "viewer: pointer-to-frame latency of a scripted drag (teapot, CAD)"),
