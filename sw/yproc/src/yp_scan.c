@@ -473,7 +473,8 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     s.use = malloc((size_t)W + 1); s.use2 = malloc(2 * (size_t)W + 2);
     double *acc = NULL;
     size_t acccap = 0;
-    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.fx || !s.tmp || !s.tolv || !s.covsum || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
+    unsigned char *mark = malloc((size_t)W + 2);   /* point samples: centres to test exactly */
+    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.fx || !s.tmp || !s.tolv || !s.covsum || !s.use || !s.use2 || !mark) { st = HSR_ENOMEM; goto done; }
     for (int y = y0; y < y1; y++)
         for (int c = 0; c < 3; c++)
             for (int x = 0; x < W; x++) fr->ideal[((size_t)c * s.H + y) * W + x] = yp_bg(sh, c, x, y);
@@ -564,10 +565,35 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
                 int x0 = xa <= 0 ? 0 : (int)((xa + HSR_SUBPIXEL - 1) / HSR_SUBPIXEL);
                 int x1 = xb < 0 ? -1 : (int)(xb / HSR_SUBPIXEL);
                 if (x1 > nx - 1) x1 = nx - 1;
-                for (int x = x0; x <= x1; x++) {
-                    if (row[x] != 0) continue;
+                if (x0 > x1) continue;
+                /* the centres near an edge crossing the row (its x at py in doubles, +-2 px,
+                 * or the whole x range of an edge within a unit of horizontal) are tested
+                 * exactly; between them no edge crosses, so a run takes its first centre's
+                 * answer */
+                memset(mark + x0, 0, (size_t)(x1 - x0 + 1));
+                for (int k = 0, ne = hsr_domain_edge_count(d); k < ne; k++) {
+                    double sg4[4];
+                    if (hsr_domain_edge(d, k, sg4) != HSR_OK) { memset(mark + x0, 1, (size_t)(x1 - x0 + 1)); break; }
+                    double ya = fmin(sg4[1], sg4[3]), yb = fmax(sg4[1], sg4[3]), za, zb;
+                    if ((double)py < ya - 1 || (double)py > yb + 1) continue;
+                    if (yb - ya < 1) { za = fmin(sg4[0], sg4[2]); zb = fmax(sg4[0], sg4[2]); }
+                    else {
+                        double xc = sg4[0] + ((double)py - sg4[1]) * (sg4[2] - sg4[0]) / (sg4[3] - sg4[1]);
+                        za = zb = fmin(fmax(xc, fmin(sg4[0], sg4[2])), fmax(sg4[0], sg4[2]));
+                    }
+                    double ia = floor((za - 2 * U) / U) - gx0 - 1, ib = ceil((zb + 2 * U) / U) - gx0 + 1;
+                    int a0 = ia < x0 ? x0 : (int)ia, b0 = ib > x1 ? x1 : (int)ib;
+                    if (a0 <= b0) memset(mark + a0, 1, (size_t)(b0 - a0 + 1));
+                }
+                for (int x = x0; x <= x1;) {
                     int64_t px = (int64_t)(gx0 + x) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
-                    if (hsr_domain_contains(d, px, py)) row[x] = 1;
+                    if (mark[x]) {
+                        if (row[x] == 0 && hsr_domain_contains(d, px, py)) row[x] = 1;
+                        x++;
+                        continue;
+                    }
+                    int in = hsr_domain_contains(d, px, py);
+                    for (; x <= x1 && !mark[x]; x++) if (in) row[x] = 1;
                 }
             }
         }
@@ -588,6 +614,6 @@ done:
     arena_free(&s.ar);
     for (int i = 0; i < 4; i++) yp_cmdlist_free(&s.wl[i]);
     yp_cmdlist_free(&s.wspec); yp_cmdlist_free(&s.wtex); free(s.fx);
-    free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
+    free(s.le); free(keys); free(acc); free(mark); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
     return st;
 }
