@@ -28,6 +28,7 @@ SECTIONS = {
     "yproc-scaling": (".yproc", "render_scaling"),
     "span": (".span", "render"),
     "viewer": (".viewer", "render"),
+    "viewer-lat": (".viewer", "render_lat"),
     "link": (".link", "render"),
 }
 

@@ -5,6 +5,10 @@ in, the frame band's bytes out) split into HSR, scan, `yproc serve` I/O, golden 
 encode; then the refinement when the pointer rests. Baseline in the same run: a frame
 rendered from scratch (a new `yproc serve`: scene load, HSR build, every line scanned,
 every line through the golden model).
+
+With --baseline-yproc PATH (issue 19 item 5's before/after) each scene is dragged with
+that `yproc` binary first and then with this tree's, in the same run, and the record is
+docs/bench/viewer-lat.json (its own section of docs/performance.md).
 """
 from __future__ import annotations
 
@@ -30,12 +34,14 @@ def pct(xs, p):
     return xs[min(len(xs) - 1, int(round(p / 100 * (len(xs) - 1))))]
 
 
-def drag(name: str, steps: int, budget: float, px: float, log, model: str = "auto") -> dict:
+def drag(name: str, steps: int, budget: float, px: float, log, model: str = "auto",
+         exe=None) -> dict:
     from ..viewer.engine import Engine
     from ..viewer.server import Session
     scene, obj, what = SCENES[name]
+    exe = exe or yproc.build()
     t0 = time.perf_counter()
-    eng = Engine(scene, yproc.build(), budget_ms=budget, model=model)
+    eng = Engine(scene, exe, budget_ms=budget, model=model)
     open_s = time.perf_counter() - t0
     full0 = eng.last_ms
     try:
@@ -63,7 +69,7 @@ def drag(name: str, steps: int, budget: float, px: float, log, model: str = "aut
         # the baseline, same run: a frame from scratch (a new `yproc serve`: scene load,
         # HSR build, every line scanned, every line through the golden model)
         t = time.perf_counter()
-        Engine(scene, yproc.build(), budget_ms=budget, model=model).close()
+        Engine(scene, exe, budget_ms=budget, model=model).close()
         full_ms = (time.perf_counter() - t) * 1e3
     finally:
         eng.close()
@@ -89,6 +95,10 @@ def configure(ap) -> None:
                     help="the viewer's frame budget (coarse frames above it)")
     ap.add_argument("--model", choices=("auto", "fast", "numpy"), default="auto",
                     help="golden model: C (diffengine.model.fast) when there (auto), or numpy")
+    ap.add_argument("--baseline-yproc", metavar="PATH",
+                    help="also drag with this yproc binary first, same run (record viewer-lat)")
+    ap.add_argument("--baseline-label", default="baseline",
+                    help="what the baseline binary is (e.g. 'main 4a92cc4'), for the table")
     ap.add_argument("--write", action="store_true",
                     help="keep the record in docs/bench and update docs/performance.md")
     ap.set_defaults(func=command)
@@ -96,45 +106,83 @@ def configure(ap) -> None:
 
 def command(a) -> int:
     import os
-    run = record.Run("viewer")
-    res = []
+    from pathlib import Path
+    base = Path(a.baseline_yproc).resolve() if a.baseline_yproc else None
+    if base is not None and not os.access(base, os.X_OK):
+        print(f"diffengine bench viewer: error: --baseline-yproc {base}: not an executable file")
+        return 2
+    run = record.Run("viewer-lat" if base else "viewer")
+    res, before = [], []
     for name in a.scenes.split(","):
         if name not in SCENES:
             run.log(f"error: unknown scene {name!r} ({', '.join(SCENES)})")
             return 2
+        if base:
+            run.log(f"{name}: {a.steps}-step drag with the baseline {base}")
+            before.append(dict(drag(name, a.steps, a.budget_ms, a.px, run.log, a.model, base),
+                               yproc=a.baseline_label))
+            r = before[-1]
+            run.log(f"{name}: baseline median {r['median_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms")
         run.log(f"{name}: {a.steps}-step drag through the viewer's server path")
         res.append(drag(name, a.steps, a.budget_ms, a.px, run.log, a.model))
         r = res[-1]
         run.log(f"{name}: median {r['median_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms; "
                 f"from scratch {r['scratch_ms']:.0f} ms")
-    rec = run.save({"scenes": res, "cpus": os.cpu_count()}, a.write)
+    data = {"scenes": res, "cpus": os.cpu_count()}
+    if base:
+        data["baseline"] = before
+    rec = run.save(data, a.write)
     if a.write:
-        return doc.write(["viewer"])
-    print(render(rec))
+        return doc.write(["viewer-lat" if base else "viewer"])
+    print(render_lat(rec) if base else render(rec))
     return 0
+
+
+def _row(r: dict, label: str) -> str:
+    s = r["stage_median_ms"]
+    return (f"| {r['scene']} ({r['faces']} faces) | {r['dragged']} | {label}"
+            f"{r.get('model', 'numpy')} | {r['steps']} | "
+            f"{r['median_ms']:.0f} | {r['p95_ms']:.0f} | {r['max_ms']:.0f} | "
+            f"{s['hsr_ms']:.0f} | {s['scan_ms']:.0f} | {s['serve_io_ms']:.0f} | "
+            f"{s['model_ms']:.0f} | {s['encode_ms']:.1f} | {r['coarse_steps']} | "
+            f"{r['rebuilt_steps']} | {r['changed_lines_median']:.0f} | {r['rest_ms']:.0f} | "
+            f"{r['scratch_ms']:.0f} |")
+
+
+def _head(rec: dict, what: str) -> list[str]:
+    d = rec["data"]
+    return [f"`{rec['command']}` ({rec['date']}, revision {rec['revision']}, load average "
+            f"{rec['load_before']} before / {rec['load_after']} after on {d['cpus']} cores; "
+            "wall-clock times, one process plus `yproc serve`, so each stage runs on one core):",
+            "",
+            f"| scene | dragged | {what}model | steps | median ms | p95 ms | max ms | HSR | scan | "
+            "serve I/O | model | encode | coarse steps | HSR rebuilds | changed lines | "
+            "rest (refine) ms | from scratch ms |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+            + ("---|" if what else "")]
+
+
+def _goal(scenes, whose: str = "") -> str:
+    goal = all(r["median_ms"] <= 50 and r["p95_ms"] <= 100 for r in scenes)
+    return ("Stage columns are per-step medians (ms). Goals (issue 19): median <= 50 ms, "
+            f"p95 <= 100 ms: **{'met' if goal else 'not met'}** in this run{whose}.")
 
 
 def render(rec: dict) -> str:
     """The "Viewer: pointer-to-frame latency" section of docs/performance.md."""
     d = rec["data"]
-    out = [f"`{rec['command']}` ({rec['date']}, revision {rec['revision']}, load average "
-           f"{rec['load_before']} before / {rec['load_after']} after on {d['cpus']} cores; "
-           "wall-clock times, one process plus `yproc serve`, so each stage runs on one core):",
-           "",
-           "| scene | dragged | model | steps | median ms | p95 ms | max ms | HSR | scan | serve I/O | "
-           "model | encode | coarse steps | HSR rebuilds | changed lines | rest (refine) ms | "
-           "from scratch ms |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in d["scenes"]:
-        s = r["stage_median_ms"]
-        out.append(f"| {r['scene']} ({r['faces']} faces) | {r['dragged']} | "
-                   f"{r.get('model', 'numpy')} | {r['steps']} | "
-                   f"{r['median_ms']:.0f} | {r['p95_ms']:.0f} | {r['max_ms']:.0f} | "
-                   f"{s['hsr_ms']:.0f} | {s['scan_ms']:.0f} | {s['serve_io_ms']:.0f} | "
-                   f"{s['model_ms']:.0f} | {s['encode_ms']:.1f} | {r['coarse_steps']} | "
-                   f"{r['rebuilt_steps']} | {r['changed_lines_median']:.0f} | {r['rest_ms']:.0f} | "
-                   f"{r['scratch_ms']:.0f} |")
-    goal = all(r["median_ms"] <= 50 and r["p95_ms"] <= 100 for r in d["scenes"])
-    out += ["", "Stage columns are per-step medians (ms). Goals (issue 19): median <= 50 ms, "
-            f"p95 <= 100 ms: **{'met' if goal else 'not met'}** in this run."]
+    out = _head(rec, "") + [_row(r, "") for r in d["scenes"]]
+    out += ["", _goal(d["scenes"])]
+    return "\n".join(out)
+
+
+def render_lat(rec: dict) -> str:
+    """The "Viewer latency: before and after" section (record viewer-lat): per scene the
+    baseline binary's drag, then this tree's, from the same run."""
+    d = rec["data"]
+    out = _head(rec, "yproc | ")
+    for b, r in zip(d["baseline"], d["scenes"]):
+        out.append(_row(b, f"{b['yproc']} | "))
+        out.append(_row(r, f"this tree ({rec['revision']}) | "))
+    out += ["", _goal(d["scenes"], " by this tree's rows")]
     return "\n".join(out)

@@ -282,12 +282,21 @@ static int line_cost(entry **e, int n, int *spec, int base)
     return t + sp;
 }
 
+/* src's commands after dst's: one copy (n and slots of a list are kept by
+ * yp_cmdlist_push, so the sum of the two is dst's new slot count) */
 static hsr_status append(yp_cmdlist *dst, const yp_cmdlist *src)
 {
-    for (int i = 0; i < src->n; i++) {
-        hsr_status st = yp_cmdlist_push(dst, src->c[i]);
-        if (st != HSR_OK) return st;
+    if (!src->n) return HSR_OK;
+    if (dst->n + src->n > dst->cap) {
+        int nc = dst->cap ? dst->cap : 16;
+        while (nc < dst->n + src->n) nc *= 2;
+        yp_cmd *p = realloc(dst->c, sizeof(yp_cmd) * (size_t)nc);
+        if (!p) return HSR_ENOMEM;
+        dst->c = p; dst->cap = nc;
     }
+    memcpy(dst->c + dst->n, src->c, sizeof(yp_cmd) * (size_t)src->n);
+    dst->n += src->n;
+    dst->slots += src->slots;
     return HSR_OK;
 }
 
@@ -418,23 +427,25 @@ static hsr_status finish_line(scan *s, int y, int c)
     return st;
 }
 
-static void count_frame(yp_frame *fr)
+/* the frame's command counts of lines y0..y1-1 added (sign 1) or taken away (-1):
+ * a scan of some lines takes their old counts away first and adds the new ones, so
+ * the totals stay those of the whole frame without a pass over every line */
+static void count_lines(yp_frame *fr, int y0, int y1, int sign)
 {
-    memset(fr->n_eval, 0, sizeof fr->n_eval);
-    fr->n_knots = fr->n_dis = fr->n_partial = fr->n_spec = 0;
-    for (int i = 0; i < 3 * fr->height; i++) {
-        const yp_cmdlist *l = &fr->line[i];
-        int after = 0;
-        for (int k = 0; k < l->n; k++) {
-            const yp_cmd *c = &l->c[k];
-            if (c->op == YP_EVAL) { fr->n_eval[c->order + 1]++; if (after) fr->n_spec++; }
-            else if (c->op == YP_EVAL0) fr->n_eval[0]++;
-            else if (c->op == YP_SETDDI) fr->n_knots++;
-            else if (c->op == YP_DIS) fr->n_dis++;
-            else if (c->op == YP_ACCMODE) after = 1;
+    for (int c = 0; c < 3; c++)
+        for (int y = y0; y < y1; y++) {
+            const yp_cmdlist *l = &fr->line[c * fr->height + y];
+            int after = 0;
+            for (int k = 0; k < l->n; k++) {
+                const yp_cmd *m = &l->c[k];
+                if (m->op == YP_EVAL) { fr->n_eval[m->order + 1] += sign; if (after) fr->n_spec += sign; }
+                else if (m->op == YP_EVAL0) fr->n_eval[0] += sign;
+                else if (m->op == YP_SETDDI) fr->n_knots += sign;
+                else if (m->op == YP_DIS) fr->n_dis += sign;
+                else if (m->op == YP_ACCMODE) after = 1;
+            }
         }
-    }
-    for (int y = 0; y < fr->height; y++) fr->n_partial += 3 * fr->st[y].partial;
+    for (int y = y0; y < y1; y++) fr->n_partial += sign * 3 * fr->st[y].partial;
 }
 
 hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, int y0, int y1, yp_frame *fr)
@@ -462,7 +473,8 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
     s.use = malloc((size_t)W + 1); s.use2 = malloc(2 * (size_t)W + 2);
     double *acc = NULL;
     size_t acccap = 0;
-    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.fx || !s.tmp || !s.tolv || !s.covsum || !s.use || !s.use2) { st = HSR_ENOMEM; goto done; }
+    unsigned char *mark = malloc((size_t)W + 2);   /* point samples: centres to test exactly */
+    if (!keys || !s.le || !s.fb || !s.fs || !s.ft || !s.fx || !s.tmp || !s.tolv || !s.covsum || !s.use || !s.use2 || !mark) { st = HSR_ENOMEM; goto done; }
     for (int y = y0; y < y1; y++)
         for (int c = 0; c < 3; c++)
             for (int x = 0; x < W; x++) fr->ideal[((size_t)c * s.H + y) * W + x] = yp_bg(sh, c, x, y);
@@ -534,17 +546,54 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
                 }
             }
         }
+        /* point samples: a pixel is in if a domain of the group contains its centre; only
+         * the centres inside a domain's extent (a closed box around it) are tested */
         for (int yy = ry0 - gy0; need_pt && yy < ry1 - gy0; yy++) {
             int ml, laa, ltx; double lt;
             line_opts(&s, gy0 + yy, &ml, &laa, &lt, &ltx);
             if (laa) continue;
-            memset(&acc[(size_t)yy * (nx + 2)], 0, sizeof(double) * (size_t)(nx + 2));
-            for (int x = 0; x < nx; x++) {
-                int64_t px = (int64_t)(gx0 + x) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
-                int64_t py = (int64_t)(gy0 + yy) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
-                for (int i = g; i < ge; i++) {
-                    const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
-                    if (hsr_domain_contains(d, px, py)) { acc[(size_t)yy * (nx + 2) + x] = 1; break; }
+            double *row = &acc[(size_t)yy * (nx + 2)];
+            memset(row, 0, sizeof(double) * (size_t)(nx + 2));
+            int64_t py = (int64_t)(gy0 + yy) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
+            for (int i = g; i < ge; i++) {
+                const hsr_domain *d; hsr_llr_get(h, keys[i].slot, &d, NULL, NULL, NULL);
+                hsr_extent e = hsr_domain_extent(d);
+                if (py < e.bot || py > e.top) continue;
+                /* pixel x's centre is (gx0 + x) * S + S / 2: the x with centres in [left, right] */
+                int64_t xa = e.left - (int64_t)gx0 * HSR_SUBPIXEL - HSR_SUBPIXEL / 2;
+                int64_t xb = e.right - (int64_t)gx0 * HSR_SUBPIXEL - HSR_SUBPIXEL / 2;
+                int x0 = xa <= 0 ? 0 : (int)((xa + HSR_SUBPIXEL - 1) / HSR_SUBPIXEL);
+                int x1 = xb < 0 ? -1 : (int)(xb / HSR_SUBPIXEL);
+                if (x1 > nx - 1) x1 = nx - 1;
+                if (x0 > x1) continue;
+                /* the centres near an edge crossing the row (its x at py in doubles, +-2 px,
+                 * or the whole x range of an edge within a unit of horizontal) are tested
+                 * exactly; between them no edge crosses, so a run takes its first centre's
+                 * answer */
+                memset(mark + x0, 0, (size_t)(x1 - x0 + 1));
+                for (int k = 0, ne = hsr_domain_edge_count(d); k < ne; k++) {
+                    double sg4[4];
+                    if (hsr_domain_edge(d, k, sg4) != HSR_OK) { memset(mark + x0, 1, (size_t)(x1 - x0 + 1)); break; }
+                    double ya = fmin(sg4[1], sg4[3]), yb = fmax(sg4[1], sg4[3]), za, zb;
+                    if ((double)py < ya - 1 || (double)py > yb + 1) continue;
+                    if (yb - ya < 1) { za = fmin(sg4[0], sg4[2]); zb = fmax(sg4[0], sg4[2]); }
+                    else {
+                        double xc = sg4[0] + ((double)py - sg4[1]) * (sg4[2] - sg4[0]) / (sg4[3] - sg4[1]);
+                        za = zb = fmin(fmax(xc, fmin(sg4[0], sg4[2])), fmax(sg4[0], sg4[2]));
+                    }
+                    double ia = floor((za - 2 * U) / U) - gx0 - 1, ib = ceil((zb + 2 * U) / U) - gx0 + 1;
+                    int a0 = ia < x0 ? x0 : (int)ia, b0 = ib > x1 ? x1 : (int)ib;
+                    if (a0 <= b0) memset(mark + a0, 1, (size_t)(b0 - a0 + 1));
+                }
+                for (int x = x0; x <= x1;) {
+                    int64_t px = (int64_t)(gx0 + x) * HSR_SUBPIXEL + HSR_SUBPIXEL / 2;
+                    if (mark[x]) {
+                        if (row[x] == 0 && hsr_domain_contains(d, px, py)) row[x] = 1;
+                        x++;
+                        continue;
+                    }
+                    int in = hsr_domain_contains(d, px, py);
+                    for (; x <= x1 && !mark[x]; x++) if (in) row[x] = 1;
                 }
             }
         }
@@ -552,9 +601,10 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
             st = row_entry(&s, keys[g].par, keys[g].nvis, y, &acc[(size_t)(y - gy0) * (nx + 2)], gx0, gx1);
         g = ge;
     }
+    count_lines(fr, y0, y1, -1);
     for (int y = y0; y < y1 && st == HSR_OK; y++)
         for (int c = 0; c < 3 && st == HSR_OK; c++) st = finish_line(&s, y, c);
-    if (st == HSR_OK) count_frame(fr);
+    count_lines(fr, y0, y1, 1);
 done:
     if (s.le) {
         for (int i = 0; i < 3 * (y1 - y0); i++) {
@@ -564,6 +614,6 @@ done:
     arena_free(&s.ar);
     for (int i = 0; i < 4; i++) yp_cmdlist_free(&s.wl[i]);
     yp_cmdlist_free(&s.wspec); yp_cmdlist_free(&s.wtex); free(s.fx);
-    free(s.le); free(keys); free(acc); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
+    free(s.le); free(keys); free(acc); free(mark); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
     return st;
 }

@@ -436,6 +436,11 @@ static void test_yp_anim_incremental_equals_full_rebuild(void)
             int y = i % H;
             if ((y < y0 || y >= y1) && !yp_cmdlist_equal(&prev[i], &ff->line[i])) changed_outside++;
         }
+        /* the frame's command counts, kept up to date for the scanned lines only, are
+         * those of the whole frame scanned from scratch */
+        CHECK(!memcmp(fr->n_eval, ff->n_eval, sizeof fr->n_eval));
+        CHECK(fr->n_knots == ff->n_knots && fr->n_dis == ff->n_dis);
+        CHECK(fr->n_partial == ff->n_partial && fr->n_spec == ff->n_spec);
         yp_frame_free(ff); hsr_destroy(hf);
     }
     CHECK(changed_outside == 0);
