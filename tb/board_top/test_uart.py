@@ -24,7 +24,6 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge, Timer
 
 HERE = Path(__file__).resolve().parent
-RTL = HERE.parent.parent / "rtl" / "board"
 sys.path.insert(0, str(HERE.parent))
 
 
@@ -95,8 +94,8 @@ async def test_rx_line(dut):
 
 
 def test_rx():
-    from common.run import build_and_test
-    build_and_test(HERE, "de_uart_rx", [RTL / "de_uart_pkg.sv", RTL / "de_uart_rx.sv"],
+    from common.run import build_and_test, rtl_files
+    build_and_test(HERE, "de_uart_rx", rtl_files("board", "uart"),
                    "test_uart",
                    parameters=dict(ClkHz=78_125_000, Baud=3_000_000), testcase="test_rx_line")
 
@@ -106,10 +105,11 @@ def test_rx():
 @pytest.mark.parametrize("mod", ["de_uart_rx", "de_uart_tx"])
 def test_rate_check(mod, clk_hz, ok, tmp_path):
     """Elaboration (no -Wno-fatal, as in lint and synthesis) passes iff the error < 2 %."""
+    from common.run import rtl_files
     vl = shutil.which("verilator")
     assert vl, "verilator not on PATH"
     r = subprocess.run([vl, "--lint-only", "-Wall", f"-GClkHz={clk_hz}", "-GBaud=3000000",
-                        "--top-module", mod, str(RTL / "de_uart_pkg.sv"), str(RTL / f"{mod}.sv"), "--Mdir", str(tmp_path)],
+                        "--top-module", mod, *map(str, rtl_files("board", "uart")), "--Mdir", str(tmp_path)],
                        capture_output=True, text=True)
     if ok:
         assert r.returncode == 0, r.stderr
