@@ -29,7 +29,10 @@ lint_top de_board_core $(files board lint)
 for f in rtl/board/*.sv; do
   case $f in
     */de_board_core.sv) ;;
-    */de_fs_player.sv) lint_top de_fs_player $(files input) "$f" ;;
+    */de_frame_player.sv) lint_top de_frame_player $(files input) "$f" ;;
+    */de_sdram_frames.sv) lint_top de_sdram_frames $(files sdram_ctrl) \
+        rtl/board/de_async_fifo.sv rtl/board/de_frame_fetch.sv $(files input) \
+        rtl/board/de_frame_player.sv "$f" ;;
     */de_uart_pkg.sv) ;;   # linted with its users below
     */de_uart_rx.sv|*/de_uart_tx.sv) lint_top "$(basename "$f" .sv)" rtl/board/de_uart_pkg.sv "$f" ;;
     */de_uart_link.sv) lint_top de_uart_link rtl/board/de_uart_{pkg,rx,tx}.sv "$f" ;;

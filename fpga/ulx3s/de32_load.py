@@ -67,6 +67,23 @@ def cmd_p(ch: int, base: int, n: int, window: int, comp: bool) -> bytes:
     return with_chk(b"P" + bytes([ch]) + struct.pack(">HHBB", base, n, window, int(comp)))
 
 
+def cmd_x(ch: int, off: int, words: list[int]) -> bytes:
+    """Write words into colour ch's SDRAM region from word offset off (loader v2)."""
+    return with_chk(b"X" + bytes([ch]) + off.to_bytes(3, "big") + struct.pack(">H", len(words))
+                    + b"".join(struct.pack(">I", w) for w in words))
+
+
+def cmd_f(ch: int, slot: int, table: int, window: int, comp: bool) -> bytes:
+    """Frame slot `slot` of colour ch: its table at word offset `table` (loader v2)."""
+    return with_chk(b"F" + bytes([ch, slot]) + table.to_bytes(3, "big")
+                    + bytes([window, int(comp)]))
+
+
+def cmd_q(first: int, count: int, hold: int, loop: bool) -> bytes:
+    """Play slots first .. first+count-1, hold frames each, from the next frame boundary."""
+    return with_chk(b"Q" + bytes([first, count, hold, int(loop)]))
+
+
 def cmd_o(shift: int, sat: bool) -> bytes:
     return with_chk(b"O" + bytes([shift, int(sat)]))
 

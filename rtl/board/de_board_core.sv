@@ -1,25 +1,30 @@
 // Board top of the Difference Engine prototype, portable core (docs/board.md).
 //
-//   uart_rx_i -> de_uart_link -> de_loader -+-> frame store R -> player R -+
-//                                          +-> frame store G -> player G -+-> display_controller
-//   uart_tx_o <- de_uart_link <-----------+-> frame store B -> player B -+   (3 arrays, NumBuf 1)
-//                                                                          |
-//   tmds_o[2:0] <- de_tmds_enc x 3 <- rgb8 / hsync / vsync / blank <-------+
+//   uart_rx_i -> de_uart_link -> de_loader --X/F/Q--> de_sdram_frames <-> sd_* (SDRAM)
+//   uart_tx_o <- de_uart_link <-+                     | players R/G/B
+//                                                     v
+//                                              display_controller (3 arrays, NumBuf 1)
+//                                                     |
+//   tmds_o[2:0] <- de_tmds_enc x 3 <- rgb8 / hsync / vsync / blank
 //
 // The pixel clock (clk_i), plus clk_core_i for the UART (always: 3 Mbaud needs a clock
 // with an integer bit period, de_uart_link) and for the span-serial arrays when
-// SpanArray = 1 (9 * NumChips columns each in block RAM, docs/fpga.md 3). The board shell (fpga/ulx3s/) adds the PLL, the 10:1 serialisers and the
-// pins. Colour: one frame store, one player and one
-// instruction buffer per colour (the display controller's one-buffer-per-colour
-// choice, docs/display-controller.md §9.1); each player is the single y-processor of
-// its colour. TMDS channel 0 is blue and carries {VSYNC, HSYNC} as {C1, C0} while
+// SpanArray = 1 (9 * NumChips columns each in block RAM, docs/fpga.md 3), plus
+// clk_sdram_i (125 MHz) for the SDRAM controller and the frame fetchers. The board shell
+// (fpga/ulx3s/) adds the PLL, the 10:1 serialisers, the SDRAM clock and the pins. The
+// frames live in SDRAM as tables of lines (docs/sdram-frames-spec.md); per colour a
+// fetcher, a 2,048-word dual-clock prefetch FIFO, a player and an instruction buffer
+// (the display controller's one-buffer-per-colour choice, docs/display-controller.md
+// §9.1); each player is the single y-processor of its colour. TMDS channel 0 is blue and carries {VSYNC, HSYNC} as {C1, C0} while
 // blanking, channel 1 green, channel 2 red (DVI 1.0 §3.1).
 `default_nettype none
 
 module de_board_core #(
   parameter int unsigned NumChips    = 1,      // chips of 9 PEs per colour array
   parameter int unsigned CarryBug    = 0,
-  parameter int unsigned FsDepth     = 1024,   // frame-store words per colour
+  parameter int unsigned PfDepth     = 2048,   // prefetch FIFO words per colour
+  parameter int unsigned SdTckPs     = 8000,   // clk_sdram_i period (125 MHz)
+  parameter int unsigned SdTinitNs   = 100_000,  // SDRAM power-up wait (tests shorten it)
   parameter int unsigned UartClkHz   = 78_125_000,  // UART on clk_core_i (de_uart_link)
   parameter int unsigned Baud        = 3_000_000,   // FT231X maximum; divider 26, 0.16 %
   parameter int unsigned TimeoutBits = 22,
@@ -34,11 +39,11 @@ module de_board_core #(
   parameter int unsigned TestVSync   = 2,
   parameter int unsigned TestVBp     = 2,
   parameter int unsigned SpanArray   = 0,      // 1: span-serial arrays on clk_core_i
-  parameter int unsigned SpanLatency = 300,    // their Refresh -> column 0, pixel clocks
-  localparam int unsigned AW = $clog2(FsDepth)
+  parameter int unsigned SpanLatency = 300     // their Refresh -> column 0, pixel clocks
 ) (
   input  logic            clk_i,
   input  logic            clk_core_i,
+  input  logic            clk_sdram_i,  // 125 MHz: the PLL's CLKOP (the TMDS bit clock)
   input  logic            rst_i,
   input  logic [1:0]      mode_i,       // video mode (display-controller.md §3), in reset
   input  logic            uart_rx_i,
@@ -49,24 +54,33 @@ module de_board_core #(
   output logic [2:0][7:0] rgb8_o,       // [0] R, [1] G, [2] B
   output logic            hsync_o,
   output logic            vsync_o,
-  output logic            blank_o
+  output logic            blank_o,
+  // SDRAM (clk_sdram_i; docs/sdram-frames-spec.md §4): DQ split for the I/O buffer.
+  output logic            sd_cke_o,
+  output logic            sd_cs_n_o,
+  output logic            sd_ras_n_o,
+  output logic            sd_cas_n_o,
+  output logic            sd_we_n_o,
+  output logic [1:0]      sd_ba_o,
+  output logic [12:0]     sd_a_o,
+  output logic [1:0]      sd_dqm_o,
+  output logic [15:0]     sd_dq_o,
+  output logic            sd_dq_oe_o,
+  input  logic [15:0]     sd_dq_i
 );
   localparam int unsigned NumCh = 3;
 
   // ------------------------------------------------------------------ UART + loader
   logic        rx_valid, rx_ferr, tx_valid, tx_ready;
   logic [7:0]  rx_data, tx_data;
-  logic [2:0]  fs_we, desc_set, pending, pix_collision;
-  logic [AW-1:0] fs_addr;
-  logic [31:0] fs_wdata;
-  logic [15:0] desc_base, desc_len, ferr_count, chk_count, cmd_count;
-  logic [2:0]  desc_window, out8_shift;
-  logic        desc_comp, out8_sat, align_err;
+  logic [2:0]  pix_collision;
+  logic [15:0] ferr_count, chk_count, cmd_count;
+  logic [2:0]  out8_shift;
+  logic        out8_sat, align_err, pending, frame, sd_cmd_valid, sd_cmd_ready;
+  logic [56:0] sd_cmd;
+  logic [7:0]  malformed, late_words;
   logic [13:0] reg_addr;
   logic [31:0] reg_rdata;
-  /* verilator lint_off UNUSEDSIGNAL */
-  logic [NumCh-1:0] frame;   // G and B play in lockstep with R; R's count is reported
-  /* verilator lint_on UNUSEDSIGNAL */
 
   de_uart_link #(.ClkHz(UartClkHz), .Baud(Baud)) u_uart (
     .clk_i, .rst_i, .clk_uart_i(clk_core_i), .rx_i(uart_rx_i), .tx_o(uart_tx_o),
@@ -75,7 +89,7 @@ module de_board_core #(
   );
 
   de_loader #(
-    .FsDepth(FsDepth), .NumChips(NumChips), .TimeoutBits(TimeoutBits)
+    .NumChips(NumChips), .TimeoutBits(TimeoutBits)
   ) u_loader (
     .clk_i, .rst_i,
     .rx_valid_i     (rx_valid),
@@ -84,28 +98,25 @@ module de_board_core #(
     .tx_valid_o     (tx_valid),
     .tx_ready_i     (tx_ready),
     .tx_data_o      (tx_data),
-    .fs_we_o        (fs_we),
-    .fs_addr_o      (fs_addr),
-    .fs_wdata_o     (fs_wdata),
-    .desc_set_o     (desc_set),
-    .desc_base_o    (desc_base),
-    .desc_len_o     (desc_len),
-    .desc_window_o  (desc_window),
-    .desc_comp_o    (desc_comp),
+    .sd_cmd_valid_o (sd_cmd_valid),
+    .sd_cmd_ready_i (sd_cmd_ready),
+    .sd_cmd_o       (sd_cmd),
     .out8_shift_o   (out8_shift),
     .out8_sat_o     (out8_sat),
     .reg_addr_o     (reg_addr),
     .reg_rdata_i    (reg_rdata),
-    .frame_i        (frame[0]),
+    .frame_i        (frame),
     .pending_i      (pending),
     .align_err_i    (align_err),
     .pix_collision_i(pix_collision),
+    .malformed_i    (malformed),
+    .late_i         (late_words),
     .rx_ferr_count_o(ferr_count),
     .chk_err_count_o(chk_count),
     .cmd_err_count_o(cmd_count)
   );
 
-  // ------------------------------------------------------------------ frame stores
+  // ------------------------------------------------------------------ SDRAM frame store
   logic [11:0] vactive;
   always_comb begin
     unique case (mode_i)
@@ -119,26 +130,32 @@ module de_board_core #(
   logic [NumCh-1:0][0:0]       wr_valid, wr_ready;
   logic [NumCh-1:0][0:0][47:0] wr_data;
 
-  for (genvar c = 0; c < NumCh; c++) begin : g_col
-    de_fs_player #(.FsDepth(FsDepth)) u_player (
-      .clk_i, .rst_i,
-      .fs_we_i      (fs_we[c]),
-      .fs_addr_i    (fs_addr),
-      .fs_wdata_i   (fs_wdata),
-      .desc_set_i   (desc_set[c]),
-      .desc_base_i  (desc_base),
-      .desc_len_i   (desc_len),
-      .desc_window_i(desc_window),
-      .desc_comp_i  (desc_comp),
-      .vactive_i    (vactive),
-      .wr_valid_o   (wr_valid[c][0]),
-      .wr_ready_i   (wr_ready[c][0]),
-      .wr_data_o    (wr_data[c][0]),
-      .frame_o      (frame[c]),
-      .pending_o    (pending[c])
-    );
-  end
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic sd_init_done;
+  /* verilator lint_on UNUSEDSIGNAL */
+  logic [NumCh-1:0]       fr_valid, fr_ready, dc_late;
+  logic [NumCh-1:0][47:0] fr_data;
 
+  de_sdram_frames #(
+    .PfDepth(PfDepth), .SdTckPs(SdTckPs), .SdTinitNs(SdTinitNs)
+  ) u_frames (
+    .clk_i, .rst_i, .clk_sdram_i,
+    .vactive_i     (vactive),
+    .cmd_valid_i   (sd_cmd_valid),
+    .cmd_ready_o   (sd_cmd_ready),
+    .cmd_i         (sd_cmd),
+    .wr_valid_o    (fr_valid),
+    .wr_ready_i    (fr_ready),
+    .wr_data_o     (fr_data),
+    .dc_late_i     (dc_late),
+    .frame_o       (frame),
+    .q_pending_o   (pending),
+    .malformed_o   (malformed),
+    .late_o        (late_words),
+    .sd_init_done_o(sd_init_done),
+    .sd_cke_o, .sd_cs_n_o, .sd_ras_n_o, .sd_cas_n_o, .sd_we_n_o, .sd_ba_o, .sd_a_o,
+    .sd_dqm_o, .sd_dq_o, .sd_dq_oe_o, .sd_dq_i
+  );
   // ------------------------------------------------------------------ display controller
   /* verilator lint_off UNUSEDSIGNAL */
   logic [11:0]            line;
@@ -196,6 +213,14 @@ module de_board_core #(
     .obs_bit_o      (obs_bit_o)
   );
 
+  // The players to the display controller's write ports (one y-processor per colour).
+  for (genvar c = 0; c < NumCh; c++) begin : g_col
+    assign wr_valid[c][0] = fr_valid[c];
+    assign fr_ready[c]    = wr_ready[c][0];
+    assign wr_data[c][0]  = fr_data[c];
+    assign dc_late[c]     = late[c][0];
+  end
+
   // ------------------------------------------------------------------ TMDS
   de_tmds_enc u_tmds_b (
     .clk_i, .rst_i, .de_i(!blank), .data_i(rgb8[2]), .c_i({vsync, hsync}), .sym_o(tmds_o[0])
@@ -209,13 +234,14 @@ module de_board_core #(
 
   // ------------------------------------------------------------------ status
   logic heart_d, heart_q;
-  always_comb heart_d = frame[0] ? ~heart_q : heart_q;
+  always_comb heart_d = frame ? ~heart_q : heart_q;
   always_ff @(posedge clk_i) begin
     if (rst_i) heart_q <= 1'b0;
     else       heart_q <= heart_d;
   end
 
-  assign led_o   = {|pending, |pix_collision, align_err, 2'b00,
+  assign led_o   = {pending || malformed != 8'd0 || late_words != 8'd0,
+                    |pix_collision, align_err, 2'b00,
                     cmd_count != 16'd0, chk_count != 16'd0 || ferr_count != 16'd0, heart_q};
   assign rgb8_o  = rgb8;
   assign hsync_o = hsync;

@@ -1,29 +1,37 @@
-// UART loader of the board top: the host's command protocol (docs/board.md §3).
+// UART loader of the board top, version 2: the host's command protocol (docs/board.md
+// §3, docs/sdram-frames-spec.md §3).
 //
-// Every command is a command byte, fixed header bytes, (for 'W') 4*N data bytes, and a
+// Every command is a command byte, fixed header bytes, (for 'X') 4*N data bytes, and a
 // checksum byte chosen so that all the command's bytes sum to 0 mod 256. Multi-byte
 // fields are big-endian. Every complete command gets a reply:
 //
-//   'W' ch a1 a0 n1 n0 {4 bytes per word}*N ck  write N words at a (frame store ch) -> K/E
-//   'P' ch b1 b0 l1 l0 win flags ck             image descriptor of ch (next frame)  -> K/E
-//   'O' shift sat ck                            8-bit output window of the DVI pixels -> K/E
-//   'R' a1 a0 ck                                read display-controller register a  -> 'R' d3..d0 / E
-//   'S' ck                                      status                              -> 'S' + 15 bytes
+//   'X' ch o2 o1 o0 n1 n0 {4 bytes per word}*N ck  write N (1..1024) words into colour
+//                                  ch's SDRAM region from offset o (< 2^21)      -> K/E
+//   'F' ch slot t2 t1 t0 win flags ck  frame slot (0..63) of ch: table offset t
+//                                  (a multiple of 4, < 2^21), window, compensation -> K/E
+//   'Q' first count hold loop ck   the sequence of slots (first + count <= 64, hold
+//                                  1..255 frames each, loop 0/1), from the next frame
+//                                  boundary                                      -> K/E
+//   'O' shift sat ck               8-bit output window of the DVI pixels          -> K/E
+//   'R' a1 a0 ck                   read display-controller register a    -> 'R' d3..d0 / E
+//   'S' ck                         status                                -> 'S' + 15 bytes
 //
+// 'W' and 'P' (version 1, the block-RAM frame stores) are gone: an old host tool gets
+// them counted as bytes that are not a command, and reads version 2 in 'S'.
 // Replies: 'K' done; 'E' checksum wrong, a field out of range, or a UART framing error
 // inside the command; 'T' the command stopped arriving (no byte for 2^TimeoutBits clocks;
-// it is abandoned). Words of a 'W' are written as they arrive (the frame store has no
-// room for a staging copy), so after an 'E' the host re-sends the command; a framing
-// error stops the writes of the rest of its command. Bytes that are not a command byte
-// are counted and skipped (resynchronisation). The host waits for each reply: a reply
-// due while the previous one is still being sent is dropped and counted.
+// it is abandoned). Words of an 'X' are written as they arrive (no staging copy), so
+// after an 'E' the host re-sends the command; a framing error stops the writes of the
+// rest of its command. X words, F and Q go to the SDRAM side (de_sdram_frames) through
+// its command FIFO, in order, one entry each; should the FIFO be full (it drains far
+// faster than the UART fills it) the command is answered 'E' and counted. Bytes that are
+// not a command byte are counted and skipped (resynchronisation). The host waits for each
+// reply: a reply due while the previous one is still being sent is dropped and counted.
 `default_nettype none
 
 module de_loader #(
-  parameter int unsigned FsDepth     = 1024,
   parameter int unsigned NumChips    = 1,
-  parameter int unsigned TimeoutBits = 22,    // 2^22 clocks = 168 ms at 25 MHz
-  localparam int unsigned AW = $clog2(FsDepth)
+  parameter int unsigned TimeoutBits = 22     // 2^22 clocks = 168 ms at 25 MHz
 ) (
   input  logic          clk_i,
   input  logic          rst_i,
@@ -34,16 +42,12 @@ module de_loader #(
   output logic          tx_valid_o,
   input  logic          tx_ready_i,
   output logic [7:0]    tx_data_o,
-  // Frame stores (one write port per colour).
-  output logic [2:0]    fs_we_o,
-  output logic [AW-1:0] fs_addr_o,
-  output logic [31:0]   fs_wdata_o,
-  // Image descriptors.
-  output logic [2:0]    desc_set_o,
-  output logic [15:0]   desc_base_o,
-  output logic [15:0]   desc_len_o,
-  output logic [2:0]    desc_window_o,
-  output logic          desc_comp_o,
+  // SDRAM side's command FIFO: {type, fields} (de_sdram_frames): type 1 X word
+  // {ch, off[20:0], word}, 2 F {ch, slot, table[20:0], window, comp}, 3 Q {first,
+  // count, hold, loop}.
+  output logic          sd_cmd_valid_o,
+  input  logic          sd_cmd_ready_i,
+  output logic [56:0]   sd_cmd_o,
   // Output window and display-controller register port.
   output logic [2:0]    out8_shift_o,
   output logic          out8_sat_o,
@@ -51,9 +55,11 @@ module de_loader #(
   input  logic [31:0]   reg_rdata_i,
   // Status sources.
   input  logic          frame_i,          // a frame played (colour R's player)
-  input  logic [2:0]    pending_i,
+  input  logic          pending_i,        // a sequence waits for a frame boundary
   input  logic          align_err_i,
   input  logic [2:0]    pix_collision_i,
+  input  logic [7:0]    malformed_i,      // malformed lines fixed by the fetchers
+  input  logic [7:0]    late_i,           // late lines for want of SDRAM data
   output logic [15:0]   rx_ferr_count_o,
   output logic [15:0]   chk_err_count_o,
   output logic [15:0]   cmd_err_count_o
@@ -64,15 +70,18 @@ module de_loader #(
 
   typedef enum logic [2:0] {SCmd, SHdr, SData, SChk, SReg} state_e;
 
-  localparam logic [7:0] CmdW = 8'h57, CmdP = 8'h50, CmdO = 8'h4F, CmdR = 8'h52,
-                         CmdS = 8'h53;
+  localparam logic [7:0] CmdX = 8'h58, CmdF = 8'h46, CmdQ = 8'h51, CmdO = 8'h4F,
+                         CmdR = 8'h52, CmdS = 8'h53;
+  localparam logic [1:0] TypX = 2'd1, TypF = 2'd2, TypQ = 2'd3;
+  localparam logic [23:0] Region = 24'h20_0000;   // words per colour region: 2^21
   localparam logic [7:0] RepK = 8'h4B, RepE = 8'h45, RepT = 8'h54;
 
   state_e      state_d, state_q;
   logic [7:0]  cmd_d, cmd_q, sum_d, sum_q;
   logic [55:0] hdr_d, hdr_q;             // header bytes, last one in [7:0]
   logic [2:0]  left_d, left_q;           // header bytes still to come
-  logic [15:0] addr_d, addr_q, nw_d, nw_q;
+  logic [23:0] addr_d, addr_q;
+  logic [15:0] nw_d, nw_q;
   logic [23:0] wsh_d, wsh_q;             // first three bytes of the current word
   logic [1:0]  wb_d, wb_q;               // byte of the current word
   logic        bad_d, bad_q;             // field or framing error in this command
@@ -85,12 +94,9 @@ module de_loader #(
   // Reply: up to 16 bytes, first byte in [127:120].
   logic [127:0] rep_d, rep_q;
   logic [4:0]   rep_n_d, rep_n_q;
-  logic [2:0]   we_d, we_q, dset_d, dset_q;
-  logic [AW-1:0] waddr_d, waddr_q;
-  logic [31:0]  wdata_d, wdata_q;
-  logic [15:0]  dbase_d, dbase_q, dlen_d, dlen_q;
-  logic [2:0]   dwin_d, dwin_q;
-  logic         dcomp_d, dcomp_q;
+  logic         scv_d, scv_q;
+  logic [56:0]  sc_d, sc_q;
+  logic         sc_ok;                  // the command FIFO takes an entry now
 
   function automatic logic [15:0] sat_inc(logic [15:0] v);
     return (v == 16'hFFFF) ? v : v + 16'd1;
@@ -120,14 +126,9 @@ module de_loader #(
     cerr_d   = cerr_q;
     kerr_d   = kerr_q;
     frames_d = frame_i ? frames_q + 16'd1 : frames_q;
-    we_d     = 3'b000;
-    waddr_d  = waddr_q;
-    wdata_d  = wdata_q;
-    dset_d   = 3'b000;
-    dbase_d  = dbase_q;
-    dlen_d   = dlen_q;
-    dwin_d   = dwin_q;
-    dcomp_d  = dcomp_q;
+    scv_d    = 1'b0;
+    sc_d     = sc_q;
+    sc_ok    = sd_cmd_ready_i && !scv_q;
     want_rep = 1'b0;
     rep_new  = '0;
     rep_new_n = 5'd0;
@@ -149,8 +150,9 @@ module de_loader #(
           bad_d = 1'b0;
           hdr_d = '0;
           unique case (b)
-            CmdW: begin state_d = SHdr; left_d = 3'd5; end
-            CmdP: begin state_d = SHdr; left_d = 3'd7; end
+            CmdX: begin state_d = SHdr; left_d = 3'd6; end
+            CmdF: begin state_d = SHdr; left_d = 3'd7; end
+            CmdQ: begin state_d = SHdr; left_d = 3'd4; end
             CmdO: begin state_d = SHdr; left_d = 3'd2; end
             CmdR: begin state_d = SHdr; left_d = 3'd2; end
             CmdS: begin state_d = SChk; end
@@ -164,12 +166,13 @@ module de_loader #(
           hdr_d  = {hdr_q[47:0], b};
           left_d = left_q - 3'd1;
           if (left_q == 3'd1) begin
-            if (cmd_q == CmdW) begin
-              // hdr_d[39:0] = ch a1 a0 n1 n0
-              addr_d  = hdr_d[31:16];
+            if (cmd_q == CmdX) begin
+              // hdr_d[47:0] = ch o2 o1 o0 n1 n0
+              addr_d  = hdr_d[39:16];
               nw_d    = hdr_d[15:0];
               wb_d    = 2'd0;
-              if (hdr_d[39:32] > 8'd2) bad_d = 1'b1;
+              if (hdr_d[47:40] > 8'd2 || hdr_d[39:16] >= Region || hdr_d[15:0] == 16'd0 ||
+                  hdr_d[15:0] > 16'd1024) bad_d = 1'b1;
               state_d = (hdr_d[15:0] == 16'd0) ? SChk : SData;
             end else begin
               state_d = SChk;
@@ -184,15 +187,14 @@ module de_loader #(
           wb_d  = wb_q + 2'd1;
           if (wb_q == 2'd3) begin
             // Write the word unless the command is already known to be bad or the
-            // address is outside the frame store.
-            if (!bad_q && hdr_q[39:32] <= 8'd2 && 32'(addr_q) < 32'(FsDepth)) begin
-              we_d[hdr_q[33:32]] = 1'b1;
+            // address is outside the region.
+            if (!bad_q && addr_q < Region && sc_ok) begin
+              scv_d = 1'b1;
+              sc_d  = {TypX, hdr_q[41:40], addr_q[20:0], wsh_q, b};
             end else begin
               bad_d = 1'b1;
             end
-            waddr_d = AW'(addr_q);
-            wdata_d = {wsh_q, b};
-            addr_d  = addr_q + 16'd1;
+            addr_d  = addr_q + 24'd1;
             nw_d    = nw_q - 16'd1;
             if (nw_q == 16'd1) state_d = SChk;
           end
@@ -212,17 +214,30 @@ module de_loader #(
           end else begin
             rep_new = {RepK, 120'd0};
             unique case (cmd_q)
-              CmdP: begin
-                // hdr_q[55:0] = ch b1 b0 l1 l0 win flags
-                if (hdr_q[55:48] > 8'd2 || hdr_q[15:8] > 8'd4 || hdr_q[7:1] != 7'd0) begin
+              CmdF: begin
+                // hdr_q[55:0] = ch slot t2 t1 t0 win flags
+                if (hdr_q[55:48] > 8'd2 || hdr_q[47:40] > 8'd63 || hdr_q[39:16] >= Region ||
+                    hdr_q[17:16] != 2'd0 || hdr_q[15:8] > 8'd4 || hdr_q[7:1] != 7'd0 ||
+                    !sc_ok) begin
                   kerr_d  = sat_inc(kerr_q);
                   rep_new = {RepE, 120'd0};
                 end else begin
-                  dset_d[hdr_q[49:48]] = 1'b1;
-                  dbase_d = hdr_q[47:32];
-                  dlen_d  = hdr_q[31:16];
-                  dwin_d  = hdr_q[10:8];
-                  dcomp_d = hdr_q[0];
+                  scv_d = 1'b1;
+                  sc_d  = {TypF, hdr_q[49:48], hdr_q[45:40], hdr_q[36:16], hdr_q[10:8],
+                           hdr_q[0], 22'd0};
+                end
+              end
+              CmdQ: begin
+                // hdr_q[31:0] = first count hold loop
+                if (hdr_q[31:24] > 8'd63 || hdr_q[23:16] == 8'd0 || hdr_q[23:16] > 8'd64 ||
+                    9'(hdr_q[31:24]) + 9'(hdr_q[23:16]) > 9'd64 || hdr_q[15:8] == 8'd0 ||
+                    hdr_q[7:0] > 8'd1 || !sc_ok) begin
+                  kerr_d  = sat_inc(kerr_q);
+                  rep_new = {RepE, 120'd0};
+                end else begin
+                  scv_d = 1'b1;
+                  sc_d  = {TypQ, 2'd0, hdr_q[29:24], hdr_q[22:16], hdr_q[15:8], hdr_q[0],
+                           31'd0};
                 end
               end
               CmdO: begin
@@ -243,10 +258,10 @@ module de_loader #(
               end
               CmdS: begin
                 rep_new_n = 5'd16;
-                rep_new = {CmdS, 8'd1, 8'(NumChips), 8'(AW),
+                rep_new = {CmdS, 8'd2, 8'(NumChips), 8'd21,
                            ferr_q, cerr_q, kerr_q, frames_q,
-                           1'b0, pending_i, pix_collision_i, align_err_i,
-                           4'd0, sat_q, shift_q, 16'd0};
+                           3'b000, pending_i, pix_collision_i, align_err_i,
+                           4'd0, sat_q, shift_q, malformed_i, late_i};
               end
               default: ;
             endcase
@@ -298,7 +313,7 @@ module de_loader #(
       sum_q    <= 8'd0;
       hdr_q    <= '0;
       left_q   <= 3'd0;
-      addr_q   <= 16'd0;
+      addr_q   <= 24'd0;
       nw_q     <= 16'd0;
       wsh_q    <= 24'd0;
       wb_q     <= 2'd0;
@@ -314,14 +329,8 @@ module de_loader #(
       frames_q <= 16'd0;
       rep_q    <= '0;
       rep_n_q  <= 5'd0;
-      we_q     <= 3'b000;
-      waddr_q  <= '0;
-      wdata_q  <= 32'd0;
-      dset_q   <= 3'b000;
-      dbase_q  <= 16'd0;
-      dlen_q   <= 16'd0;
-      dwin_q   <= 3'd0;
-      dcomp_q  <= 1'b0;
+      scv_q    <= 1'b0;
+      sc_q     <= '0;
     end else begin
       state_q  <= state_d;
       cmd_q    <= cmd_d;
@@ -344,27 +353,15 @@ module de_loader #(
       frames_q <= frames_d;
       rep_q    <= rep_d;
       rep_n_q  <= rep_n_d;
-      we_q     <= we_d;
-      waddr_q  <= waddr_d;
-      wdata_q  <= wdata_d;
-      dset_q   <= dset_d;
-      dbase_q  <= dbase_d;
-      dlen_q   <= dlen_d;
-      dwin_q   <= dwin_d;
-      dcomp_q  <= dcomp_d;
+      scv_q    <= scv_d;
+      sc_q     <= sc_d;
     end
   end
 
   assign tx_valid_o      = (rep_n_q != 5'd0);
   assign tx_data_o       = rep_q[127:120];
-  assign fs_we_o         = we_q;
-  assign fs_addr_o       = waddr_q;
-  assign fs_wdata_o      = wdata_q;
-  assign desc_set_o      = dset_q;
-  assign desc_base_o     = dbase_q;
-  assign desc_len_o      = dlen_q;
-  assign desc_window_o   = dwin_q;
-  assign desc_comp_o     = dcomp_q;
+  assign sd_cmd_valid_o  = scv_q;
+  assign sd_cmd_o        = sc_q;
   assign out8_shift_o    = shift_q;
   assign out8_sat_o      = sat_q;
   assign reg_addr_o      = raddr_q;

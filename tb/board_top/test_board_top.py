@@ -6,27 +6,33 @@ every reachable running-disparity state and decodes back to itself; the running
 disparity of the symbols the RTL sends never leaves [-8, 8] (the model's reachable set);
 control tokens in blanking, cnt restarting at 0.
 
-test_load_and_play (toplevel de_board_core, 1-chip arrays, small test video mode):
-a host model builds a .de32 image per colour from a random command list (sw/diffengine:
-randgen -> frame-store grid -> binfmt.framestore_encode / encode_de32), sends it over the
-UART line at 3 Mbaud in real time (the board's rate; the UART runs on clk_core_i at
-UartClkHz, 78.125 MHz as on the board, 26 clocks per bit) with the loader protocol of
-docs/board.md §3, with one checksum error, one corrupted data byte inside a 'W' of the
-image (NACKed 'E', re-sent, then 'K'; the image check proves the re-send overwrote the
-bad word), one UART framing error and one garbage byte injected;
-then the testbench decodes the three TMDS symbol streams back to pixels, hsync and vsync
-and checks, exactly:
-  * every displayed frame of every colour is either the previous image or the new one,
-    switching once, at a frame boundary, and ends on the new one; the new image equals
-    functional.render() of binfmt.map_word() of the frame-store words (window and
-    compensation flag of the .de32) with the carry bug on, through the 8-bit output
+test_load_and_play (toplevel tb_board_sdram: de_board_core with the timing-checking
+SDRAM model sim/models/sdram_sdr16.sv on its pins, 1-chip arrays, small test video mode):
+a host model builds three frames per colour from random command lists (sw/diffengine:
+randgen -> frame-store grid -> binfmt.framestore_encode), frames 1 and 2 changing a few
+lines of the frame before, stores them as tables of lines (docs/sdram-frames-spec.md:
+identical line blocks once, single-marker lines as empty entries), and sends them over
+the UART line at 3 Mbaud in real time (the board's rate; the UART runs on clk_core_i at
+UartClkHz, 78.125 MHz as on the board, 26 clocks per bit) with the loader protocol v2
+('X' words, 'F' slots, 'Q' sequences), with one checksum error, one corrupted data byte
+inside an 'X' (NACKed 'E', re-sent, then 'K'; the image check proves the re-send
+overwrote the bad word), one UART framing error and one garbage byte injected; then the
+testbench decodes the three TMDS symbol streams back to pixels, hsync and vsync and
+checks, exactly:
+  * black frames before any sequence; after Q(first 0, count 1): every displayed frame is
+    black or image 0, switching once, at a frame boundary; image k equals
+    functional.render() of binfmt.map_word() of its frame-store words (window and
+    compensation flag of the slot) with the carry bug on, through the 8-bit output
     selection ('O' command);
-  * a second image loaded at another base and switched in (double buffering) the same;
+  * after Q(0, 3, hold 2, loop): every displayed frame equals one of the three images as
+    a whole (all three colours the same frame: never a mix of two frames, never a colour
+    out of step), in the order 0 0 1 1 2 2 0 0 1 1 ... (each hold frames, wrapping);
   * sync: DE runs of HActive, hsync HSync wide and HFp after DE, HTotal apart, frames of
     VActive lines; control tokens only in blanking, data symbols only in DE;
-  * the loader's replies, the status counters (framing, checksum, command errors, all
-    exactly 1-2 as injected), the controller ID and the Load Monitors' late-line and
-    dropped-word totals (0) read over the UART.
+  * the loader's replies, the status (version 2, region 2^21 words; framing, checksum,
+    command errors exactly as injected; no malformed line, no late word), the controller
+    ID and the Load Monitors' late-line and dropped-word totals (0) read over the UART;
+  * the SDRAM model saw 0 timing violations and the controller refreshed.
 Parametrised runs: plain (78.125 MHz / 3 Mbaud, divider error 0.16 %), nearlimit
 (76.5 MHz / 3 Mbaud: divider 26 is 1.96 % slow against the host's exact 3 Mbaud, just
 under the 2 % elaboration limit), span (span-serial arrays; UART at 256.4 MHz).
@@ -53,7 +59,7 @@ sys.path.insert(0, str(HERE.parent.parent / "fpga" / "ulx3s"))
 
 import tmds  # noqa: E402
 # The host tool's command encoders: the test checks them against the RTL too.
-from de32_load import cmd_p, cmd_w, with_chk  # noqa: E402
+from de32_load import cmd_f, cmd_q, cmd_x, with_chk  # noqa: E402
 from diffengine.formats import binfmt  # noqa: E402
 from diffengine.model import functional
 from diffengine import isa
@@ -61,6 +67,8 @@ from diffengine.regress import randgen
 
 NCH = 3
 PIX_PS = 40000          # pixel clock period (25 MHz)
+SD_PS = 8000            # SDRAM clock period (125 MHz)
+MARKER = 0x0800_0000    # the end-of-line marker (REFRESH, LUT code 1), operand 0
 
 
 # ====================================================================== TMDS encoder
@@ -140,7 +148,7 @@ async def test_tmds_encoder(dut):
 def geom(dut) -> dict:
     g = {k: int(getattr(dut, k).value) for k in (
         "TestHActive", "TestHFp", "TestHSync", "TestHBp", "TestVActive", "TestVFp",
-        "TestVSync", "TestVBp", "NumChips", "CarryBug", "FsDepth", "UartClkHz",
+        "TestVSync", "TestVBp", "NumChips", "CarryBug", "PfDepth", "UartClkHz",
         "Baud", "TimeoutBits")}
     g["HTotal"] = g["TestHActive"] + g["TestHFp"] + g["TestHSync"] + g["TestHBp"]
     g["VTotal"] = g["TestVActive"] + g["TestVFp"] + g["TestVSync"] + g["TestVBp"]
@@ -255,23 +263,68 @@ class Host:
         await self.send(data, bad_stop_at=bad_stop_at)
         return await self.reply(n_reply, timeout=timeout)
 
-    async def load(self, ch: int, base: int, words: list[int], chunk: int = 24,
+    async def load(self, ch: int, off: int, words: list[int], chunk: int = 24,
                    corrupt: int | None = None) -> int:
-        """Write words in 'W' packets; the packet with index `corrupt` is first sent with
+        """Write words in 'X' packets; the packet with index `corrupt` is first sent with
         one data byte flipped (its bad word is written: the loader has no staging copy),
         must be NACKed 'E', and is re-sent. Returns the number of NACKs seen."""
         nacks = 0
         for k, a in enumerate(range(0, len(words), chunk)):
-            pkt = cmd_w(ch, base + a, words[a:a + chunk])
+            pkt = cmd_x(ch, off + a, words[a:a + chunk])
             if k == corrupt:
                 bad = bytearray(pkt)
                 bad[7] ^= 0x10                 # first data byte
                 r = await self.command(bytes(bad))
-                assert r == b"E", f"corrupted W ch{ch} @{base + a}: reply {r!r}, want E"
+                assert r == b"E", f"corrupted X ch{ch} @{off + a}: reply {r!r}, want E"
                 nacks += 1
             r = await self.command(pkt)
-            assert r == b"K", f"W ch{ch} @{base + a}: reply {r!r}"
+            assert r == b"K", f"X ch{ch} @{off + a}: reply {r!r}"
         return nacks
+
+
+def split_lines(words: list[int]) -> list[list[int]]:
+    lines, cur = [], []
+    for w in words:
+        cur.append(w)
+        if w >> 27 == 1:
+            lines.append(cur)
+            cur = []
+    assert not cur, "words after the last marker"
+    return lines
+
+
+def pack_tables(frames: list[list[int]], vactive: int) -> tuple[list[int], list[int]]:
+    """One colour's frames (frame-store words) as tables of lines in its region
+    (docs/sdram-frames-spec.md §1): identical line blocks stored once, a line that is
+    only the marker as an empty entry (len 0). Returns the region's words from offset 0
+    (gaps 0) and each frame's table offset."""
+    mem: list[int] = []
+    blocks: dict[tuple, int] = {}
+    tables = []
+
+    def put(ws: list[int]) -> int:
+        off = len(mem)
+        mem.extend(ws)
+        mem.extend([0] * (-len(mem) % 4))
+        return off
+
+    entries = []
+    for words in frames:
+        ent = []
+        lines = split_lines(words)
+        assert len(lines) == vactive
+        for ln in lines:
+            if ln == [MARKER]:
+                ent.append(0)
+                continue
+            key = tuple(ln)
+            if key not in blocks:
+                blocks[key] = put(ln)
+            ent.append(len(ln) << 20 | blocks[key] // 4)
+        entries.append(ent)
+    for ent in entries:
+        tables.append(put(ent))
+    return mem, tables
 
 
 class Video:
@@ -341,6 +394,7 @@ class Video:
 
 async def reset(dut, g):
     cocotb.start_soon(Clock(dut.clk_i, PIX_PS, unit="ps").start())
+    cocotb.start_soon(Clock(dut.clk_sdram_i, SD_PS, unit="ps").start())
     # The core clock (the UART's, and the span-serial arrays' when SpanArray = 1),
     # unrelated in phase to the pixel clock, at UartClkHz to the nearest picosecond.
     cocotb.start_soon(Clock(dut.clk_core_i, round(1e12 / g["UartClkHz"]), unit="ps").start())
@@ -364,6 +418,21 @@ def check_switch(frames, old, new, what):
         assert s.endswith("n") and "no" not in s, f"{what}: colour {c} sequence {''.join(seq)}"
 
 
+def frame_index(f: np.ndarray, imgs: list[list[np.ndarray]]) -> list[int]:
+    """Which images (all three colours) the displayed frame equals."""
+    return [k for k, im in enumerate(imgs)
+            if all(np.array_equal(f[:, :, c], im[c]) for c in range(NCH))]
+
+
+def change_lines(rng, g, words: list[int], window: int, n: int) -> list[int]:
+    """The frame with n random lines replaced by new random lines."""
+    lines = split_lines(words)
+    for v in rng.sample(range(len(lines)), n):
+        cmds = make_image(rng, g, window, max_words=g["HTotal"] - 4)
+        lines[v] = split_lines(binfmt.framestore_encode(cmds, window))[v]
+    return [w for ln in lines for w in ln]
+
+
 @cocotb.test()
 async def test_load_and_play(dut):
     from common.run import seed_from_env
@@ -374,20 +443,35 @@ async def test_load_and_play(dut):
     host = Host(dut, g)
     video = Video(dut, g)
     ftime = g["HTotal"] * g["VTotal"]
+    va = g["TestVActive"]
 
-    # Images: one per colour, windows 2/0/4, compensation on R and G (carry bug is on).
+    # Three frames per colour: windows 2/0/4, compensation on R and G (carry bug is on);
+    # frame k+1 changes two lines of frame k in every colour. The three RGB images must
+    # differ, or the sequence check below could not tell them apart.
     windows, comps = [2, 0, 4], [True, True, False]
-    de32 = []
-    for c in range(NCH):
-        cmds = make_image(rng, g, windows[c], max_words=g["HTotal"] - 4)
-        words = binfmt.framestore_encode(cmds, windows[c])
-        de32.append(binfmt.encode_de32(words, windows[c], comps[c]))
     shift, sat = 1, True
+    for _ in range(20):
+        fw = [[], [], []]          # fw[f][c]: frame-store words
+        for c in range(NCH):
+            cmds = make_image(rng, g, windows[c], max_words=g["HTotal"] - 4)
+            fw[0].append(binfmt.framestore_encode(cmds, windows[c]))
+        for f in (1, 2):
+            fw[f] = [change_lines(rng, g, fw[f - 1][c], windows[c], 2) for c in range(NCH)]
+        imgs = [[golden(binfmt.encode_de32(fw[f][c], windows[c], comps[c]), g, shift, sat)
+                 for c in range(NCH)] for f in range(3)]
+        if all(len(frame_index(np.stack(imgs[f], axis=2), imgs)) == 1 for f in range(3)):
+            break
+    else:
+        raise AssertionError("no three distinct random images in 20 tries")
+    assert sum(int(np.count_nonzero(p)) for im in imgs for p in im) > 0, "all black: no test"
+    packed = [pack_tables([fw[f][c] for f in range(3)], va) for c in range(NCH)]
+    shared = sum(len(fw[f][c]) for f in range(3) for c in range(NCH)) - \
+        sum(len(m) for m, _ in packed)
 
-    # Before any load: black frames.
+    # Before any sequence: black frames.
     video.on = True
     await ClockCycles(dut.clk_i, 3 * ftime)
-    black = [np.zeros((g["TestVActive"], g["n_pe"]), np.uint8)] * NCH
+    black = [np.zeros((va, g["n_pe"]), np.uint8)] * NCH
     pre = video.frames()
     assert pre, "no frame before loading"
     for f in pre:
@@ -395,52 +479,60 @@ async def test_load_and_play(dut):
 
     # Output window, then the errors the loader must report.
     assert await host.command(with_chk(b"O" + bytes([shift, int(sat)]))) == b"K"
-    w0 = binfmt.decode_de32(de32[2])[0]
-    bad = bytearray(cmd_w(2, 0, w0[:4]))
+    bad = bytearray(cmd_x(2, 0, fw[0][2][:4]))
     bad[-1] ^= 0x5A
     assert await host.command(bytes(bad)) == b"E", "checksum error not reported"
     await host.send(b"\x00")                               # garbage between commands
-    r = await host.command(cmd_w(2, 0, w0[:4]), bad_stop_at=9,
+    r = await host.command(cmd_x(2, 0, fw[0][2][:4]), bad_stop_at=9,
                            timeout=(1 << g["TimeoutBits"]) + 400 * g["bit_pix"])
     assert r == b"T", f"framing error inside a command: reply {r!r}, want T (abandoned)"
 
-    # Load the three images, then their descriptors.
+    # Load the three colours' regions (line blocks and tables), define slots 0-2.
     nacks = 0
     for c in range(NCH):
-        words, window, comp = binfmt.decode_de32(de32[c])
-        nacks += await host.load(c, 0, words, corrupt=0 if c == 1 else None)
+        nacks += await host.load(c, 0, packed[c][0], corrupt=0 if c == 1 else None)
     assert nacks == 1
     for c in range(NCH):
-        words, window, comp = binfmt.decode_de32(de32[c])
-        assert await host.command(cmd_p(c, 0, len(words), window, comp)) == b"K"
-    await ClockCycles(dut.clk_i, 6 * ftime)
-    new = [golden(d, g, shift, sat) for d in de32]
-    assert sum(int(np.count_nonzero(p)) for p in new) > 0, "golden image all black: no test"
+        for f in range(3):
+            r = await host.command(cmd_f(c, f, packed[c][1][f], windows[c], comps[c]))
+            assert r == b"K", f"F colour {c} slot {f}: {r!r}"
+
+    # One frame: Q(0, 1).
+    assert await host.command(cmd_q(0, 1, 1, False)) == b"K"
+    # The frames in flight (prefetch FIFO, player, instruction buffer: up to 36 words, six
+    # black frames of 6 markers) play first.
+    await ClockCycles(dut.clk_i, 16 * ftime)
     frames = video.frames()[len(pre):]
-    check_switch(frames, black, new, "first image")
+    check_switch(frames, black, imgs[0], "first image")
     n_first = len(frames)
 
-    # Double buffering: a second red image at base 128, switched in by its descriptor.
-    cmds2 = make_image(rng, g, 3, max_words=g["HTotal"] - 4)
-    words2 = binfmt.framestore_encode(cmds2, 3)
-    de32_2 = binfmt.encode_de32(words2, 3, False)
-    await host.load(0, 128, words2)
-    assert await host.command(cmd_p(0, 128, len(words2), 3, False)) == b"K"
-    await ClockCycles(dut.clk_i, 5 * ftime)
-    new2 = [golden(de32_2, g, shift, sat)] + new[1:]
+    # The sequence 0 0 1 1 2 2 0 0 ...: Q(0, 3, hold 2, loop).
+    assert await host.command(cmd_q(0, 3, 2, True)) == b"K"
+    await ClockCycles(dut.clk_i, 24 * ftime)
     frames2 = video.frames()[len(pre) + n_first:]
-    check_switch(frames2, new, new2, "second image")
+    seq = []
+    for i, f in enumerate(frames2):
+        ks = frame_index(f, imgs)
+        assert len(ks) == 1, (f"sequence: frame {i} is none of the three images (a mix?): "
+                              f"{[frame_index(f[:, :, c:c + 1], [[im[c]] for im in imgs]) for c in range(NCH)]}")
+        seq.append(ks[0])
+    s_ = "".join(map(str, seq))
+    rest = s_.lstrip("0")
+    cycle = "112200" * (len(rest) // 6 + 2)
+    assert cycle.startswith(rest), f"sequence {s_}: after the 0s, not 1 1 2 2 0 0 ..."
+    assert len(rest) >= 8, f"sequence {s_}: no wrap seen (too few frames)"
 
     # Status and registers over the UART.
     n_video = len(video.frames())       # frames shown before the status request
     st = await host.command(with_chk(b"S"), n_reply=16)
-    assert st[0] == ord("S") and st[1] == 1 and st[2] == g["NumChips"], st
-    assert st[3] == (g["FsDepth"] - 1).bit_length()
+    assert st[0] == ord("S") and st[1] == 2 and st[2] == g["NumChips"], st
+    assert st[3] == 21
     ferr, cerr, kerr, nfr = (int.from_bytes(st[k:k + 2], "big") for k in (4, 6, 8, 10))
     assert (ferr, cerr, kerr) == (1, 2, 2), (
         f"error counters framing/checksum/command = {ferr}/{cerr}/{kerr}, want 1/2/2")
     assert st[12] == 0, f"flags {st[12]:#x}: align_err / collision / pending set"
     assert st[13] == (int(sat) << 3 | shift)
+    assert st[14] == 0 and st[15] == 0, f"malformed lines {st[14]}, late words {st[15]}"
     assert nfr >= n_video, f"player frames {nfr} < displayed {n_video}"
     regs = {}
     for name, addr in [("id", 0x3000)] + [(f"late{c}", c << 12 | 0x00A) for c in range(NCH)] \
@@ -453,9 +545,14 @@ async def test_load_and_play(dut):
     for c in range(NCH):
         assert regs[f"late{c}"] == 0 and regs[f"drop{c}"] == 0, regs
     assert regs["frames0"] >= n_video - 1, regs
-    dut._log.info(f"board top: {n_first} + {len(frames2)} frames after the loads match the "
-                  f"golden model; status {ferr}/{cerr}/{kerr} errors, {nfr} frames played, "
-                  f"registers {dict((k, hex(v)) for k, v in regs.items())}")
+    nerr, nref = int(dut.err_count_o.value), int(dut.ref_count_o.value)
+    assert nerr == 0, f"the SDRAM model saw {nerr} timing violations"
+    assert nref > 0, "the controller never refreshed"
+    dut._log.info(f"board top on SDRAM: {n_first} frames after Q(0,1) and {len(frames2)} "
+                  f"after Q(0,3,2,loop) match the golden model, sequence {s_}; "
+                  f"{sum(len(m) for m, _ in packed)} words stored ({shared} shared); status "
+                  f"{ferr}/{cerr}/{kerr} errors, {nfr} frames played; SDRAM {nerr} violations, "
+                  f"{nref} refreshes; registers {dict((k, hex(v)) for k, v in regs.items())}")
 
 
 # ====================================================================== board shell
@@ -530,7 +627,8 @@ async def test_shell_serialiser(dut):
 
 
 # ====================================================================== pytest runners
-BOARD = dict(NumChips=1, CarryBug=1, FsDepth=256, UartClkHz=78_125_000, Baud=3_000_000,
+BOARD = dict(NumChips=1, CarryBug=1, PfDepth=16, SdTinitNs=2000, UartClkHz=78_125_000,
+             Baud=3_000_000,
              TimeoutBits=11,
              BufDepth=16, MaxLines=8, TestHActive=9, TestHFp=2, TestHSync=3, TestHBp=3,
              TestVActive=6, TestVFp=1, TestVSync=2, TestVBp=2)
@@ -538,7 +636,7 @@ BOARD = dict(NumChips=1, CarryBug=1, FsDepth=256, UartClkHz=78_125_000, Baud=3_0
 
 def board_sources():
     from common.run import rtl_files
-    return rtl_files("board")
+    return rtl_files("diffengine:tb:board_top", "sdram")
 
 
 def test_tmds():
@@ -558,7 +656,7 @@ def test_board(kind):
     params = {"plain": BOARD, "nearlimit": dict(BOARD, UartClkHz=76_500_000),
               "span": dict(BOARD, SpanArray=1, SpanLatency=18,
                            UartClkHz=256_410_256)}[kind]
-    build_and_test(HERE, "de_board_core", board_sources(), "test_board_top",
+    build_and_test(HERE, "tb_board_sdram", board_sources(), "test_board_top",
                    parameters=params, testcase="test_load_and_play")
 
 

@@ -1,0 +1,131 @@
+// Dual-clock FIFO (docs/board.md §4): the board's prefetch FIFOs (SDRAM clock -> pixel
+// clock, Width 36, Depth 2048: four DP16KD in 2048 x 9) and the loader's command FIFO
+// (pixel clock -> SDRAM clock, a few entries).
+//
+// Pointers are Depth-wrapping binary counters with one extra bit, each mirrored in Gray
+// code in a register of its own domain; the other domain sees the Gray pointer through
+// two flip-flops (ASYNC_REG), so a pointer in flight is either its old or its new value
+// and full / empty are conservative, never wrong.
+//
+// Write side: wready_o = not full; wfree_o = free entries, registered and conservative
+// (it counts every push up to this clock, and pops only once they have crossed), for a
+// writer that reserves room ahead (credit: the SDRAM read bursts of de_frame_fetch).
+// Read side: show-ahead (rvalid_o / rdata_o / rready_o). The memory is read only when
+// the synchronised write pointer says the entry is written, at least one read clock after
+// the synchroniser saw it, into the output register, so the two ports never touch the
+// same entry in the same clock: a dual-clock block RAM with a registered read.
+`default_nettype none
+
+module de_async_fifo #(
+  parameter int unsigned Width = 36,
+  parameter int unsigned Depth = 2048,     // a power of two, >= 4
+  localparam int unsigned AW = $clog2(Depth)
+) (
+  // Write side.
+  input  logic             wclk_i,
+  input  logic             wrst_i,        // synchronous to wclk_i
+  input  logic             wvalid_i,
+  output logic             wready_o,
+  input  logic [Width-1:0] wdata_i,
+  output logic [AW:0]      wfree_o,
+  // Read side.
+  input  logic             rclk_i,
+  input  logic             rrst_i,        // synchronous to rclk_i
+  output logic             rvalid_o,
+  input  logic             rready_i,
+  output logic [Width-1:0] rdata_o
+);
+  if (Depth < 4 || Depth > 65536 || (Depth & (Depth - 1)) != 0) begin : g_bad_depth
+    $fatal(1, "de_async_fifo: Depth must be a power of two, 4..65536, got %0d", Depth);
+  end
+  if (Width < 1) begin : g_bad_width
+    $fatal(1, "de_async_fifo: Width must be >= 1");
+  end
+
+  typedef logic [AW:0] ptr_t;
+
+  function automatic ptr_t bin2gray(ptr_t b);
+    return b ^ (b >> 1);
+  endfunction
+
+  function automatic ptr_t gray2bin(ptr_t g);
+    ptr_t b;
+    b[AW] = g[AW];
+    for (int i = int'(AW) - 1; i >= 0; i--) b[i] = b[i + 1] ^ g[i];
+    return b;
+  endfunction
+
+  logic [Width-1:0] mem_q [Depth];
+
+  // ---------------------------------------------------------------- write side
+  ptr_t wbin_d, wbin_q, wgray_q, rbin_w_q, wfree_d, wfree_q;
+  (* ASYNC_REG = "TRUE" *) ptr_t rgray_w1_q, rgray_w2_q;
+  logic push;
+
+  // The read pointer in binary is registered too (one more clock of conservatism): the
+  // Gray decode is off the 125 MHz write side's paths.
+  assign wready_o = (wbin_q - rbin_w_q) != ptr_t'(Depth);
+  assign push     = wvalid_i && wready_o;
+  assign wbin_d   = push ? wbin_q + 1'b1 : wbin_q;
+  assign wfree_d  = ptr_t'(Depth) - (wbin_d - rbin_w_q);
+
+  always_ff @(posedge wclk_i) begin
+    if (push) mem_q[wbin_q[AW-1:0]] <= wdata_i;
+  end
+
+  always_ff @(posedge wclk_i) begin
+    if (wrst_i) begin
+      wbin_q     <= '0;
+      wgray_q    <= '0;
+      rgray_w1_q <= '0;
+      rgray_w2_q <= '0;
+      rbin_w_q   <= '0;
+      wfree_q    <= ptr_t'(Depth);
+    end else begin
+      wbin_q     <= wbin_d;
+      wgray_q    <= bin2gray(wbin_d);
+      rgray_w1_q <= rgray_q;
+      rgray_w2_q <= rgray_w1_q;
+      rbin_w_q   <= gray2bin(rgray_w2_q);
+      wfree_q    <= wfree_d;
+    end
+  end
+  assign wfree_o = wfree_q;
+
+  // ---------------------------------------------------------------- read side
+  ptr_t rbin_d, rbin_q, rgray_q;
+  (* ASYNC_REG = "TRUE" *) ptr_t wgray_r1_q, wgray_r2_q;
+  logic             empty, load, dout_v_d, dout_v_q;
+  logic [Width-1:0] dout_q;
+
+  assign empty    = (rgray_q == wgray_r2_q);
+  // The output register takes the head when it is free or being emptied.
+  assign load     = !empty && (!dout_v_q || rready_i);
+  assign rbin_d   = load ? rbin_q + 1'b1 : rbin_q;
+  assign dout_v_d = load || (dout_v_q && !rready_i);
+
+  always_ff @(posedge rclk_i) begin
+    if (load) dout_q <= mem_q[rbin_q[AW-1:0]];
+  end
+
+  always_ff @(posedge rclk_i) begin
+    if (rrst_i) begin
+      rbin_q     <= '0;
+      rgray_q    <= '0;
+      wgray_r1_q <= '0;
+      wgray_r2_q <= '0;
+      dout_v_q   <= 1'b0;
+    end else begin
+      rbin_q     <= rbin_d;
+      rgray_q    <= bin2gray(rbin_d);
+      wgray_r1_q <= wgray_q;
+      wgray_r2_q <= wgray_r1_q;
+      dout_v_q   <= dout_v_d;
+    end
+  end
+
+  assign rvalid_o = dout_v_q;
+  assign rdata_o  = dout_q;
+endmodule
+
+`default_nettype wire

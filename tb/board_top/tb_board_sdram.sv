@@ -1,0 +1,89 @@
+// Test top for tb/board_top/test_board_top.py::test_board: the board core
+// rtl/board/de_board_core.sv with the timing-checking SDRAM model sim/models/sdram_sdr16.sv
+// on its SDRAM pins, as on the board (the I/O buffer joins sd_dq_o / sd_dq_oe_o and the
+// model's dq_o / dq_oe_o at the DQ pins, as tb/de_sdram_ctrl/tb_sdram_ctrl.sv does).
+// The core's parameters pass through; SdTinitNs shortens the power-up wait of both the
+// controller and the model. err_count_o: the model's timing violations.
+`default_nettype none
+
+module tb_board_sdram #(
+  parameter int unsigned NumChips    = 1,
+  parameter int unsigned CarryBug    = 0,
+  parameter int unsigned PfDepth     = 2048,
+  parameter int unsigned SdTinitNs   = 100_000,
+  parameter int unsigned UartClkHz   = 78_125_000,
+  parameter int unsigned Baud        = 3_000_000,
+  parameter int unsigned TimeoutBits = 22,
+  parameter int unsigned BufDepth    = 16,
+  parameter int unsigned MaxLines    = 512,
+  parameter int unsigned TestHActive = 16,
+  parameter int unsigned TestHFp     = 2,
+  parameter int unsigned TestHSync   = 3,
+  parameter int unsigned TestHBp     = 3,
+  parameter int unsigned TestVActive = 6,
+  parameter int unsigned TestVFp     = 1,
+  parameter int unsigned TestVSync   = 2,
+  parameter int unsigned TestVBp     = 2,
+  parameter int unsigned SpanArray   = 0,
+  parameter int unsigned SpanLatency = 300
+) (
+  input  wire logic            clk_i,
+  input  wire logic            clk_core_i,
+  input  wire logic            clk_sdram_i,
+  input  wire logic            rst_i,
+  input  wire logic [1:0]      mode_i,
+  input  wire logic            uart_rx_i,
+  output      logic            uart_tx_o,
+  output      logic [2:0][9:0] tmds_o,
+  output      logic [7:0]      led_o,
+  output      logic [2:0][7:0] rgb8_o,
+  output      logic            hsync_o,
+  output      logic            vsync_o,
+  output      logic            blank_o,
+  // The model's checker.
+  output      logic [31:0]     err_count_o,
+  output      logic [31:0]     ref_count_o
+);
+  logic        cke, cs_n, ras_n, cas_n, we_n, c_oe, m_oe;
+  logic [1:0]  ba, dqm;
+  logic [12:0] a;
+  logic [15:0] c_dq, m_dq, bus;
+
+  de_board_core #(
+    .NumChips(NumChips), .CarryBug(CarryBug), .PfDepth(PfDepth), .SdTckPs(8000),
+    .SdTinitNs(SdTinitNs), .UartClkHz(UartClkHz), .Baud(Baud), .TimeoutBits(TimeoutBits),
+    .BufDepth(BufDepth), .MaxLines(MaxLines), .TestHActive(TestHActive),
+    .TestHFp(TestHFp), .TestHSync(TestHSync), .TestHBp(TestHBp),
+    .TestVActive(TestVActive), .TestVFp(TestVFp), .TestVSync(TestVSync),
+    .TestVBp(TestVBp), .SpanArray(SpanArray), .SpanLatency(SpanLatency)
+  ) u_core (
+    .clk_i, .clk_core_i, .clk_sdram_i, .rst_i, .mode_i, .uart_rx_i, .uart_tx_o, .tmds_o,
+    .led_o, .rgb8_o, .hsync_o, .vsync_o, .blank_o,
+    .sd_cke_o(cke), .sd_cs_n_o(cs_n), .sd_ras_n_o(ras_n), .sd_cas_n_o(cas_n),
+    .sd_we_n_o(we_n), .sd_ba_o(ba), .sd_a_o(a), .sd_dqm_o(dqm),
+    .sd_dq_o(c_dq), .sd_dq_oe_o(c_oe), .sd_dq_i(bus)
+  );
+
+  // The DQ pins: whoever drives; both at once is the model's DQ violation (and X here).
+  assign bus = c_oe ? c_dq : (m_oe ? m_dq : 16'hzzzz);
+
+  logic [15:0] err_seen;
+  logic [3:0]  err_code;
+  logic [31:0] cycle;
+  logic        init_done_m;
+  logic [2:0]  cl_m;
+  logic [9:0]  bl_m;
+
+  sdram_sdr16 #(.TckPs(8000), .TinitNs(SdTinitNs)) u_sdram (
+    .clk_i(clk_sdram_i), .rst_i,
+    .cke_i(cke), .cs_n_i(cs_n), .ras_n_i(ras_n), .cas_n_i(cas_n), .we_n_i(we_n),
+    .ba_i(ba), .a_i(a), .dqm_i(dqm), .dq_i(c_dq), .dq_o(m_dq), .dq_oe_o(m_oe),
+    .err_count_o, .err_seen_o(err_seen), .err_code_o(err_code), .cycle_o(cycle),
+    .init_done_o(init_done_m), .ref_count_o, .cl_o(cl_m), .bl_o(bl_m)
+  );
+
+  logic unused;
+  assign unused = ^{err_seen, err_code, cycle, init_done_m, cl_m, bl_m};
+endmodule
+
+`default_nettype wire
