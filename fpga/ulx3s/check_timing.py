@@ -35,7 +35,8 @@ def main() -> int:
     ap.add_argument("--stat", required=True)
     ap.add_argument("--log", required=True)
     ap.add_argument("--num-chips", type=int, required=True)
-    ap.add_argument("--fs-depth", type=int, required=True)
+    ap.add_argument("--pf-depth", type=int, required=True,
+                    help="prefetch FIFO words per colour (the frames are in the SDRAM)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--span", type=int, default=0)
     ap.add_argument("--out", required=True)
@@ -51,7 +52,8 @@ def main() -> int:
              (f"configuration: span-serial arrays, {9 * a.num_chips} columns x 3 colours on the "
               "78.125 MHz core clock, " if a.span else
               f"configuration: NumChips {a.num_chips} per colour ({9 * a.num_chips} PEs x 3 colours), ") +
-             f"frame store {a.fs_depth} words x 3 colours, NumBuf 1, BufDepth 16, mode 0 "
+             f"SDRAM frame store, prefetch FIFOs {a.pf_depth} words x 3 colours, NumBuf 1, "
+             "BufDepth 16, mode 0 "
              f"(640x480 timing, 25.0 MHz pixel clock)",
              f"nextpnr seed {a.seed}", "",
              "Synthesis (yosys synth_ecp5), cells of the whole board top:"]
@@ -89,7 +91,7 @@ def main() -> int:
     out = Path(a.out)
     out.with_suffix(".txt").write_text(text)
     out.with_suffix(".json").write_text(json.dumps(
-        {"num_chips": a.num_chips, "fs_depth": a.fs_depth, "seed": a.seed, "tool": tool,
+        {"num_chips": a.num_chips, "pf_depth": a.pf_depth, "seed": a.seed, "tool": tool,
          "span": a.span,
          "synth_cells": syn, "placed": util, "clocks": clocks, "pass": ok}, indent=1) + "\n")
     return 0 if ok else 1

@@ -1,7 +1,8 @@
 // ULX3S (LFE5U-85F-6 CABGA381) board shell around the portable core rtl/board/
 // de_board_core.sv (docs/board.md §7).
 //
-//   clk_25mhz -> EHXPLLL (VCO 625 MHz) -> CLKOP 125 MHz (TMDS DDR bit clock, 5x)
+//   clk_25mhz -> EHXPLLL (VCO 625 MHz) -> CLKOP 125 MHz (TMDS DDR bit clock, 5x; also
+//                                         the SDRAM controller's clock, clk_sdram_i)
 //                                      -> CLKOS  25 MHz (pixel clock)
 //                                      -> CLKOS2 78.125 MHz (span-serial arrays' core
 //                                         clock, SpanArray = 1: 625 / 8; the arrays'
@@ -10,6 +11,12 @@
 //   ftdi_txd (FPGA receives) / ftdi_rxd (FPGA transmits): the loader's UART
 //   gpdi_dp[3:0]: TMDS blue/green/red/clock through ODDRX1F, 2 bits per 125 MHz clock;
 //   the pins are LVCMOS33D (fpga/ulx3s/ulx3s.lpf), so each N pin is driven inverted.
+//   sdram_*: the 32 MB SDR SDRAM, the frame store (docs/board.md §9): commands and
+//   addresses straight from the controller's output registers (clk_shift), DQ through
+//   BB buffers (T = not output enable), sdram_clk = clk_shift forwarded inverted by an
+//   ODDRX1F (D0 0, D1 1: 180 degrees), so the part samples the commands in the middle of
+//   their 8 ns and its read data lands in the controller's capture window (the timing
+//   analysis and what it assumes: docs/board.md §9).
 //
 // Pixel clock 25.0 MHz rather than 25.175 MHz (docs/board.md §5): 25 MHz x 5 = 125 MHz
 // comes from the board oscillator with integer dividers; 25.175 MHz would need a
@@ -27,7 +34,17 @@ module ulx3s_top (
   input  logic       ftdi_txd,
   output logic       ftdi_rxd,
   output logic [7:0] led,
-  output logic [3:0] gpdi_dp
+  output logic [3:0] gpdi_dp,
+  output logic        sdram_clk,
+  output logic        sdram_cke,
+  output logic        sdram_csn,
+  output logic        sdram_rasn,
+  output logic        sdram_casn,
+  output logic        sdram_wen,
+  output logic [1:0]  sdram_ba,
+  output logic [12:0] sdram_a,
+  output logic [1:0]  sdram_dqm,
+  inout  wire  [15:0] sdram_d
 );
   // ------------------------------------------------------------------ clocks
   logic clk_shift, clk_pix, clk_core, pll_locked;
@@ -102,9 +119,13 @@ module ulx3s_top (
   logic            hsync, vsync, blank;
   /* verilator lint_on UNUSEDSIGNAL */
 
+  logic [15:0] sd_dq_o, sd_dq_i;
+  logic        sd_dq_oe;
+
   de_board_core u_core (
     .clk_i    (clk_pix),
     .clk_core_i(clk_core),
+    .clk_sdram_i(clk_shift),
     .rst_i    (rst_pix),
     .mode_i   (2'd0),          // 640x480 timing (VESA DMT totals 800 x 525)
     .uart_rx_i(ftdi_txd),
@@ -114,9 +135,26 @@ module ulx3s_top (
     .rgb8_o   (rgb8),
     .hsync_o  (hsync),
     .vsync_o  (vsync),
-    .blank_o  (blank)
+    .blank_o  (blank),
+    .sd_cke_o  (sdram_cke),
+    .sd_cs_n_o (sdram_csn),
+    .sd_ras_n_o(sdram_rasn),
+    .sd_cas_n_o(sdram_casn),
+    .sd_we_n_o (sdram_wen),
+    .sd_ba_o   (sdram_ba),
+    .sd_a_o    (sdram_a),
+    .sd_dqm_o  (sdram_dqm),
+    .sd_dq_o   (sd_dq_o),
+    .sd_dq_oe_o(sd_dq_oe),
+    .sd_dq_i   (sd_dq_i)
   );
   assign led = led_core;
+
+  // ------------------------------------------------------------------ SDRAM pins
+  for (genvar i = 0; i < 16; i++) begin : g_dq
+    BB u_bb (.I(sd_dq_o[i]), .T(~sd_dq_oe), .O(sd_dq_i[i]), .B(sdram_d[i]));
+  end
+  ODDRX1F u_sdram_clk (.SCLK(clk_shift), .RST(1'b0), .D0(1'b0), .D1(1'b1), .Q(sdram_clk));
 
   // ------------------------------------------------------------------ 10:1 serialisers
   // The pixel domain toggles pix_tog_q every pixel clock, together with the symbols.

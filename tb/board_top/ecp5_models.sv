@@ -1,4 +1,4 @@
-// Simulation stand-ins for the two ECP5 primitives of fpga/ulx3s/ulx3s_top.sv, for
+// Simulation stand-ins for the ECP5 primitives of fpga/ulx3s/ulx3s_top.sv, for
 // test_board_top.py::test_shell only. The PLL's outputs are registers the testbench
 // clocks (pixel and bit clock at a chosen phase) and its LOCK a register it sets; the
 // DDR output register only has to exist: the test reads its D0/D1 inputs, which
@@ -37,5 +37,15 @@ module ODDRX1F (
   output logic Q
 );
   assign Q = D0;
+endmodule
+
+// Bidirectional I/O buffer (the SDRAM's DQ): drives B with I unless T, reads B on O.
+module BB (
+  input  logic I, T,
+  output logic O,
+  inout  wire  B
+);
+  assign B = T ? 1'bz : I;
+  assign O = B;
 endmodule
 /* verilator lint_on UNUSEDSIGNAL */
