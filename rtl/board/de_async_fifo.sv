@@ -57,10 +57,17 @@ module de_async_fifo #(
 
   logic [Width-1:0] mem_q [Depth];
 
-  // ---------------------------------------------------------------- write side
+  // Write side.
   ptr_t wbin_d, wbin_q, wgray_q, rbin_w_q, wfree_d, wfree_q;
   (* ASYNC_REG = "TRUE" *) ptr_t rgray_w1_q, rgray_w2_q;
   logic push;
+  // Read side.
+  ptr_t rbin_d, rbin_q, rgray_q;
+  (* ASYNC_REG = "TRUE" *) ptr_t wgray_r1_q, wgray_r2_q;
+  logic             empty, load, dout_v_d, dout_v_q;
+  logic [Width-1:0] dout_q;
+
+  // ---------------------------------------------------------------- write side
 
   // The read pointer in binary is registered too (one more clock of conservatism): the
   // Gray decode is off the 125 MHz write side's paths.
@@ -93,10 +100,6 @@ module de_async_fifo #(
   assign wfree_o = wfree_q;
 
   // ---------------------------------------------------------------- read side
-  ptr_t rbin_d, rbin_q, rgray_q;
-  (* ASYNC_REG = "TRUE" *) ptr_t wgray_r1_q, wgray_r2_q;
-  logic             empty, load, dout_v_d, dout_v_q;
-  logic [Width-1:0] dout_q;
 
   assign empty    = (rgray_q == wgray_r2_q);
   // The output register takes the head when it is free or being emptied.
