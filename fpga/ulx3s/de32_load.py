@@ -1,19 +1,22 @@
 #!/usr/bin/env python3
 """Load a scene and its animation into the board over the UART loader (docs/board.md §3).
 
-    de32_load.py PORT SCENE [--anim DIR] [--window W --round] [--resume]
-    de32_load.py PORT r.de32 g.de32 b.de32 [--base 0] [--shift 0] [--nosat]
+    de32_load.py PORT SCENE [--anim DIR] [--window W --round] [--hold N] [--resume]
+    de32_load.py PORT r.de32 g.de32 b.de32 [--shift 0] [--nosat]
     de32_load.py PORT --status | --reg 0x3000
 
 SCENE is what `make demo` writes (a directory with r/g/b .de48 streams, e.g.
 out/demo_cmd) or three r g b files (.de32 frame-store images or .de48 streams);
 --anim adds every frame of a `make anim` output directory (frame000/ and the
-frameNNN.delta files). Each frame's three colours are stored one after the other in
-each colour's frame store from --base; the descriptors ('P') then show frame --show
-(default 0), and the output window ('O') is set. .de48 streams are turned into
-frame-store words at DAC window --window; with --round, operands are rounded to that
-window's grid (otherwise a value the frame store cannot hold is an error naming the
-file and slot).
+frameNNN.delta files). The frames go into the board's SDRAM as tables of lines
+(loader version 2, docs/sdram-frames-spec.md; fpga/ulx3s/frame_pack.py): each colour's
+line blocks are stored once however many frames share them ('X'), each frame is a slot
+('F': its table, window, compensation), and the sequence ('Q') plays the frames in
+order, --hold display frames each, in a loop (--no-loop: stop on the last); --show F
+plays frame F alone. The output window ('O') is set last. .de48 streams are turned
+into frame-store words at DAC window --window; with --round, operands are rounded to
+that window's grid (otherwise a value the frame store cannot hold is an error naming
+the file and slot).
 
 Link: 3,000,000 baud 8N1 (--baud), the FT231X's maximum, as the bitstream is built.
 Every packet is answered: 'K' next packet; 'E' (checksum or field error) or 'T' (the
@@ -42,7 +45,9 @@ from pathlib import Path
 
 BAUD = 3_000_000
 ABANDON_S = 0.3          # > the loader's 2^22 pixel clocks (168 ms) of idle timeout
-PACKET_WORDS = 256       # words per 'W' (the count field is 16 bits)
+PACKET_WORDS = 256       # words per 'X' (the loader takes 1..1024)
+MAX_PACKET_WORDS = 1024
+VERSION = 2              # the loader protocol this tool speaks ('S' byte 1)
 
 
 class LoadError(Exception):
@@ -56,15 +61,6 @@ class LinkDropped(LoadError):
 # ---------------------------------------------------------------------------- packets
 def with_chk(body: bytes) -> bytes:
     return body + bytes([(-sum(body)) & 0xFF])
-
-
-def cmd_w(ch: int, addr: int, words: list[int]) -> bytes:
-    return with_chk(b"W" + bytes([ch]) + struct.pack(">HH", addr, len(words))
-                    + b"".join(struct.pack(">I", w) for w in words))
-
-
-def cmd_p(ch: int, base: int, n: int, window: int, comp: bool) -> bytes:
-    return with_chk(b"P" + bytes([ch]) + struct.pack(">HHBB", base, n, window, int(comp)))
 
 
 def cmd_x(ch: int, off: int, words: list[int]) -> bytes:
@@ -186,35 +182,32 @@ def read_anim(d: str, window, rnd) -> list[list[Image]]:
 
 
 # ---------------------------------------------------------------------------- the plan
-def plan_packets(frames: list[list[Image]], base: int, words: int, show: int,
-                 shift: int, sat: bool, fs_words: int | None):
-    """Every packet in order, and the frame layout [(frame, colour, base, n)]."""
-    pkts, layout = [], []
-    nxt = [base] * 3
-    for f, fr in enumerate(frames):
-        for c, (w, _, _) in enumerate(fr):
-            layout.append((f, c, nxt[c], len(w)))
-            nxt[c] += len(w)
-    top = max(nxt)
-    if top > 0x10000:
-        raise LoadError(f"the frames need {top} words per colour; the loader's 'W' address "
-                        "is 16 bits (65,536 words): the SDRAM store needs the wider write of "
-                        "docs/board.md §3")
-    if fs_words is not None and top > fs_words:
-        raise LoadError(f"the frames need {top} words per colour; the board's frame store "
-                        f"holds {fs_words}")
-    for f, c, b, n in layout:
-        w = frames[f][c][0]
-        for k in range(0, n, words):
-            pkts.append(cmd_w(c, b + k, w[k:k + words]))
-    if not 0 <= show < len(frames):
-        raise LoadError(f"--show {show}: there are {len(frames)} frames")
-    for f, c, b, n in layout:
-        if f == show:
-            _, window, comp = frames[f][c]
-            pkts.append(cmd_p(c, b, n, window, comp))
+def plan_packets(frames: list[list[Image]], words: int, shift: int, sat: bool,
+                 region_bits: int = 21, hold: int = 1, show: int | None = None,
+                 loop: bool = True):
+    """Every packet in order ('X' runs of at most `words` words, 'F' per frame and
+    colour, 'Q', 'O'), and the frame_pack.Plan they come from."""
+    import frame_pack
+    lines = sum(1 for w in frames[0][0][0] if frame_pack.is_marker(w))
+    try:
+        plan = frame_pack.pack(frames, lines, hold=hold, loop=loop and len(frames) > 1,
+                               region_words=1 << region_bits)
+    except frame_pack.PackError as e:
+        raise LoadError(str(e)) from None
+    pkts = []
+    for ch, off, ws in plan.writes:
+        for k in range(0, len(ws), words):
+            pkts.append(cmd_x(ch, off + k, ws[k:k + words]))
+    for ch, slot, toff, window, comp in plan.slots:
+        pkts.append(cmd_f(ch, slot, toff, window, comp))
+    first, count, hold, lp = plan.sequence
+    if show is not None:
+        if not 0 <= show < count:
+            raise LoadError(f"--show {show}: there are {count} frames")
+        first, count, hold, lp = first + show, 1, 1, 0
+    pkts.append(cmd_q(first, count, hold, bool(lp)))
     pkts.append(cmd_o(shift, sat))
-    return pkts, layout
+    return pkts, plan
 
 
 def plan_hash(pkts: list[bytes]) -> str:
@@ -398,12 +391,15 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--anim", help="make anim output directory: load all its frames too")
     ap.add_argument("--window", type=int, choices=range(5), help="DAC window for .de48")
     ap.add_argument("--round", action="store_true", help="round .de48 operands to the window")
-    ap.add_argument("--base", type=lambda s: int(s, 0), default=0, help="first word (0)")
-    ap.add_argument("--show", type=int, default=0, help="frame the descriptors show (0)")
+    ap.add_argument("--show", type=int, help="play this frame alone (default: all, in order)")
+    ap.add_argument("--hold", type=int, default=1,
+                    help="display frames per animation frame, 1..255 (1)")
+    ap.add_argument("--no-loop", action="store_true",
+                    help="stop on the last frame instead of looping")
     ap.add_argument("--shift", type=int, default=0, help="8-bit output window [shift+7:shift]")
     ap.add_argument("--nosat", action="store_true", help="wrap instead of clamping")
     ap.add_argument("--words", type=int, default=PACKET_WORDS,
-                    help=f"words per 'W' packet, 1..65535 ({PACKET_WORDS})")
+                    help=f"words per 'X' packet, 1..{MAX_PACKET_WORDS} ({PACKET_WORDS})")
     ap.add_argument("--baud", type=int, default=BAUD, help=f"({BAUD})")
     ap.add_argument("--retries", type=int, default=5, help="re-sends per packet (5)")
     ap.add_argument("--abandon", type=float, default=ABANDON_S,
@@ -411,7 +407,7 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--state", default="de32_load.state.json", help="state file for --resume")
     ap.add_argument("--resume", action="store_true", help="continue an interrupted load")
     ap.add_argument("--no-size-check", action="store_true",
-                    help="do not ask the board ('S') for its frame-store size first")
+                    help="do not ask the board ('S') for its version and region size first")
     ap.add_argument("--status", action="store_true", help="print the board's status")
     ap.add_argument("--reg", type=lambda s: int(s, 0), help="read a controller register")
     return ap
@@ -419,8 +415,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None, port_fd: int | None = None) -> int:
     a = build_parser().parse_args(argv)
-    if not 1 <= a.words <= 0xFFFF:
-        print(f"de32_load: --words {a.words} outside 1..65535", file=sys.stderr)
+    if not 1 <= a.words <= MAX_PACKET_WORDS:
+        print(f"de32_load: --words {a.words} outside 1..{MAX_PACKET_WORDS}", file=sys.stderr)
+        return 1
+    if not 1 <= a.hold <= 255:
+        print(f"de32_load: --hold {a.hold} outside 1..255", file=sys.stderr)
         return 1
     try:
         frames = []
@@ -432,12 +431,16 @@ def main(argv=None, port_fd: int | None = None) -> int:
         loader = Loader(port, a.retries, a.abandon,
                         log=lambda m: print(f"\nde32_load: {m}", file=sys.stderr))
         if frames:
-            fs_words = None
+            region_bits = 21
             if not a.no_size_check:
                 st = loader.command(with_chk(b"S"), 16)
-                fs_words = 1 << st[3]
-            pkts, layout = plan_packets(frames, a.base, a.words, a.show, a.shift,
-                                        not a.nosat, fs_words)
+                if st[1] != VERSION:
+                    raise LoadError(f"the board speaks loader version {st[1]}; this tool "
+                                    f"speaks version {VERSION} (SDRAM frames): rebuild the "
+                                    "bitstream (make fpga-board)")
+                region_bits = st[3]
+            pkts, plan = plan_packets(frames, a.words, a.shift, not a.nosat, region_bits,
+                                      a.hold, a.show, not a.no_loop)
             state = State(a.state, plan_hash(pkts), len(pkts))
             start = state.load() if a.resume else 0
             if start == len(pkts):
@@ -447,17 +450,22 @@ def main(argv=None, port_fd: int | None = None) -> int:
                     print(f"de32_load: resuming at packet {start} of {len(pkts)}",
                           file=sys.stderr)
                 run_plan(loader, pkts, state, start)
+            st = plan.stats()
+            q = plan.sequence if a.show is None else (a.show, 1, 1, 0)
             print(f"loaded {len(frames)} frame(s), {len(pkts)} packets, "
-                  f"{loader.resent} re-sent; words per colour "
-                  f"{[sum(n for f, c, b, n in layout if c == ch) for ch in range(3)]} "
-                  f"from base {a.base}; showing frame {a.show}")
+                  f"{loader.resent} re-sent; SDRAM words per colour "
+                  f"{[c['words_used'] for c in st]} (line blocks "
+                  f"{[c['blocks_stored'] for c in st]} for "
+                  f"{[c['lines_referenced'] for c in st]} lines); sequence first {q[0]} "
+                  f"count {q[1]} hold {q[2]} loop {q[3]}")
         if a.status:
             s = loader.command(with_chk(b"S"), 16)
             f = struct.unpack(">HHHH", s[4:12])
-            print(f"version {s[1]} chips/colour {s[2]} frame store 2^{s[3]} words; errors: "
-                  f"framing {f[0]} checksum {f[1]} command {f[2]}; frames {f[3]}; "
-                  f"flags {s[12]:#04x} (bit0 align_err, 1-3 collision, 4-6 pending); "
-                  f"output shift {s[13] & 7} sat {s[13] >> 3 & 1}")
+            print(f"version {s[1]} chips/colour {s[2]} SDRAM region 2^{s[3]} words per colour; "
+                  f"errors: framing {f[0]} checksum {f[1]} command {f[2]}; frames {f[3]}; "
+                  f"flags {s[12]:#04x} (bit0 align_err, 1-3 collision, 4 sequence pending); "
+                  f"output shift {s[13] & 7} sat {s[13] >> 3 & 1}; malformed lines {s[14]}, "
+                  f"late lines for want of SDRAM data {s[15]}")
         if a.reg is not None:
             r = loader.command(with_chk(b"R" + struct.pack(">H", a.reg)), 5)
             print(f"reg {a.reg:#06x} = {struct.unpack('>I', r[1:])[0]:#010x}")

@@ -1,10 +1,15 @@
-"""Pure-Python model of the board's UART loader (rtl/board/de_loader.sv, docs/board.md §3),
-for testing the host tool without a board. Imports nothing from cocotb.
+"""Pure-Python model of the board's UART loader, version 2 (rtl/board/de_loader.sv,
+docs/board.md §3, docs/sdram-frames-spec.md §3), for testing the host tool without a
+board. Imports nothing from cocotb.
 
 LoaderModel.feed(data) consumes host bytes and returns the reply bytes, byte for byte
-what the RTL would send: commands 'W' 'P' 'O' 'R' 'S', checksum (all bytes of a command
-sum to 0 mod 256), replies 'K' / 'E' / 'T', words written as they arrive, bytes that are
-not a command byte skipped and counted, status counters saturating at 0xFFFF.
+what the RTL would send: commands 'X' 'F' 'Q' 'O' 'R' 'S', checksum (all bytes of a
+command sum to 0 mod 256), replies 'K' / 'E' / 'T', X words written as they arrive into
+the colour's SDRAM region (`mem[ch]`, offset -> word), F into `slots[ch]`, Q into
+`sequence` (the RTL applies it at the next frame boundary), bytes that are not a command
+byte (the retired 'W' and 'P' among them) skipped and counted, status counters
+saturating at 0xFFFF. The RTL's command FIFO to the SDRAM side is taken never to be full
+(it drains far faster than the UART fills it).
 LoaderModel.idle() is the RTL's idle timer: a command that stopped arriving is abandoned
 with 'T'.
 
@@ -20,18 +25,22 @@ import threading
 import time
 from dataclasses import dataclass, field
 
-HEADER = {ord("W"): 5, ord("P"): 7, ord("O"): 2, ord("R"): 2, ord("S"): 0}
+HEADER = {ord("X"): 6, ord("F"): 7, ord("Q"): 4, ord("O"): 2, ord("R"): 2, ord("S"): 0}
+VERSION = 2
+REGION_BITS = 21                                # log2 words per colour region
+REGION = 1 << REGION_BITS
+MAX_X_WORDS = 1024
+SLOTS = 64
 
 
 class LoaderModel:
-    def __init__(self, fs_depth: int = 1024, num_chips: int = 1,
-                 regs: dict[int, int] | None = None):
-        self.fs_depth = fs_depth
-        self.aw = max(1, (fs_depth - 1).bit_length())
+    def __init__(self, num_chips: int = 1, regs: dict[int, int] | None = None):
         self.num_chips = num_chips
-        self.fs = [[0] * fs_depth for _ in range(3)]
-        self.desc = [None, None, None]          # (base, len, window, comp) per colour
+        self.mem: list[dict[int, int]] = [{}, {}, {}]     # per colour: offset -> word
+        self.slots: list[dict[int, tuple]] = [{}, {}, {}]  # slot -> (table, window, comp)
+        self.sequence: tuple | None = None      # (first, count, hold, loop), last Q
         self.out8 = (0, 1)                      # shift, sat
+        self.malformed = self.late = 0          # the SDRAM side's counters (status)
         self.regs = regs or {}
         self.ferr = self.cerr = self.kerr = self.frames = 0
         self.writes = 0                         # words written, for the tests
@@ -80,16 +89,16 @@ class LoaderModel:
         self.buf.append(b)
         n = len(self.buf) - 1                       # bytes after the command byte
         hdr = HEADER[self.cmd]
-        if self.cmd == ord("W") and n >= hdr:
-            ch, addr, nw = self.buf[1], int.from_bytes(self.buf[2:4], "big"), \
-                int.from_bytes(self.buf[4:6], "big")
-            if n == hdr and ch > 2:
+        if self.cmd == ord("X") and n >= hdr:
+            ch, off, nw = self.buf[1], int.from_bytes(self.buf[2:5], "big"), \
+                int.from_bytes(self.buf[5:7], "big")
+            if n == hdr and (ch > 2 or off >= REGION or nw == 0 or nw > MAX_X_WORDS):
                 self.bad = True
             data_n = n - hdr
             if 0 < data_n <= 4 * nw and data_n % 4 == 0:
-                a = addr + data_n // 4 - 1
-                if not self.bad and ch <= 2 and a < self.fs_depth:
-                    self.fs[ch][a] = int.from_bytes(self.buf[-4:], "big")
+                a = off + data_n // 4 - 1
+                if not self.bad and a < REGION:
+                    self.mem[ch][a] = int.from_bytes(self.buf[-4:], "big")
                     self.writes += 1
                 else:
                     self.bad = True
@@ -109,26 +118,33 @@ class LoaderModel:
             self.kerr = self._inc(self.kerr)
             return b"E"
         h = buf[1:-1]
-        if cmd == ord("P"):
-            self.desc[h[0]] = (int.from_bytes(h[1:3], "big"), int.from_bytes(h[3:5], "big"),
-                               h[5], bool(h[6] & 1))
+        if cmd == ord("F"):
+            self.slots[h[0]][h[1]] = (int.from_bytes(h[2:5], "big"), h[5], bool(h[6] & 1))
+        elif cmd == ord("Q"):
+            self.sequence = (h[0], h[1], h[2], h[3])
         elif cmd == ord("O"):
             self.out8 = (h[0], h[1] & 1)
         elif cmd == ord("R"):
             v = self.regs.get(int.from_bytes(h, "big") & 0x3FFF, 0)
             return b"R" + v.to_bytes(4, "big")
         elif cmd == ord("S"):
-            return (b"S" + bytes([1, self.num_chips & 0xFF, self.aw])
+            return (b"S" + bytes([VERSION, self.num_chips & 0xFF, REGION_BITS])
                     + b"".join(v.to_bytes(2, "big") for v in
                                (self.ferr, self.cerr, self.kerr, self.frames))
-                    + bytes([0, self.out8[1] << 3 | self.out8[0], 0, 0]))
+                    + bytes([0, self.out8[1] << 3 | self.out8[0],
+                             min(self.malformed, 255), min(self.late, 255)]))
         return b"K"
 
     @staticmethod
     def _bad_fields(cmd: int, buf: bytes) -> bool:
         h = buf[1:-1]
-        if cmd == ord("P"):
-            return h[0] > 2 or h[5] > 4 or bool(h[6] & 0xFE)
+        if cmd == ord("F"):
+            table = int.from_bytes(h[2:5], "big")
+            return (h[0] > 2 or h[1] >= SLOTS or table >= REGION or table % 4 != 0
+                    or h[5] > 4 or bool(h[6] & 0xFE))
+        if cmd == ord("Q"):
+            return (h[0] >= SLOTS or not 1 <= h[1] <= SLOTS or h[0] + h[1] > SLOTS
+                    or h[2] == 0 or h[3] > 1)
         if cmd == ord("O"):
             return h[0] > 4 or bool(h[1] & 0xFE)
         return False

@@ -10,8 +10,9 @@ test_load_and_play (toplevel tb_board_sdram: de_board_core with the timing-check
 SDRAM model sim/models/sdram_sdr16.sv on its pins, 1-chip arrays, small test video mode):
 a host model builds three frames per colour from random command lists (sw/diffengine:
 randgen -> frame-store grid -> binfmt.framestore_encode), frames 1 and 2 changing a few
-lines of the frame before, stores them as tables of lines (docs/sdram-frames-spec.md:
-identical line blocks once, single-marker lines as empty entries), and sends them over
+lines of the frame before, packs them as tables of lines (fpga/ulx3s/frame_pack.py,
+docs/sdram-frames-spec.md: identical line blocks once, single-marker lines as empty
+entries), and sends them over
 the UART line at 3 Mbaud in real time (the board's rate; the UART runs on clk_core_i at
 UartClkHz, 78.125 MHz as on the board, 26 clocks per bit) with the loader protocol v2
 ('X' words, 'F' slots, 'Q' sequences), with one checksum error, one corrupted data byte
@@ -60,6 +61,7 @@ sys.path.insert(0, str(HERE.parent.parent / "fpga" / "ulx3s"))
 import tmds  # noqa: E402
 # The host tool's command encoders: the test checks them against the RTL too.
 from de32_load import cmd_f, cmd_q, cmd_x, with_chk  # noqa: E402
+import frame_pack  # noqa: E402
 from diffengine.formats import binfmt  # noqa: E402
 from diffengine.model import functional
 from diffengine import isa
@@ -293,40 +295,6 @@ def split_lines(words: list[int]) -> list[list[int]]:
     return lines
 
 
-def pack_tables(frames: list[list[int]], vactive: int) -> tuple[list[int], list[int]]:
-    """One colour's frames (frame-store words) as tables of lines in its region
-    (docs/sdram-frames-spec.md §1): identical line blocks stored once, a line that is
-    only the marker as an empty entry (len 0). Returns the region's words from offset 0
-    (gaps 0) and each frame's table offset."""
-    mem: list[int] = []
-    blocks: dict[tuple, int] = {}
-    tables = []
-
-    def put(ws: list[int]) -> int:
-        off = len(mem)
-        mem.extend(ws)
-        mem.extend([0] * (-len(mem) % 4))
-        return off
-
-    entries = []
-    for words in frames:
-        ent = []
-        lines = split_lines(words)
-        assert len(lines) == vactive
-        for ln in lines:
-            if ln == [MARKER]:
-                ent.append(0)
-                continue
-            key = tuple(ln)
-            if key not in blocks:
-                blocks[key] = put(ln)
-            ent.append(len(ln) << 20 | blocks[key] // 4)
-        entries.append(ent)
-    for ent in entries:
-        tables.append(put(ent))
-    return mem, tables
-
-
 class Video:
     """Samples the TMDS symbols every clock and decodes them (tmds.decode)."""
 
@@ -464,9 +432,13 @@ async def test_load_and_play(dut):
     else:
         raise AssertionError("no three distinct random images in 20 tries")
     assert sum(int(np.count_nonzero(p)) for im in imgs for p in im) > 0, "all black: no test"
-    packed = [pack_tables([fw[f][c] for f in range(3)], va) for c in range(NCH)]
-    shared = sum(len(fw[f][c]) for f in range(3) for c in range(NCH)) - \
-        sum(len(m) for m, _ in packed)
+    plan = frame_pack.pack([[(fw[f][c], windows[c], comps[c]) for c in range(NCH)]
+                            for f in range(3)], va)
+    stats = plan.stats()
+    stored = sum(st["words_used"] for st in stats)
+    blocks = sum(st["blocks_stored"] for st in stats)
+    assert blocks < sum(st["lines_referenced"] - st["empty_lines"] for st in stats), \
+        "no line block shared between frames: the sharing is not tested"
 
     # Before any sequence: black frames.
     video.on = True
@@ -489,13 +461,13 @@ async def test_load_and_play(dut):
 
     # Load the three colours' regions (line blocks and tables), define slots 0-2.
     nacks = 0
-    for c in range(NCH):
-        nacks += await host.load(c, 0, packed[c][0], corrupt=0 if c == 1 else None)
+    for k, (ch, off, words) in enumerate(plan.writes):
+        nacks += await host.load(ch, off, words, corrupt=0 if k == 1 else None)
     assert nacks == 1
-    for c in range(NCH):
-        for f in range(3):
-            r = await host.command(cmd_f(c, f, packed[c][1][f], windows[c], comps[c]))
-            assert r == b"K", f"F colour {c} slot {f}: {r!r}"
+    for ch, slot, toff, window, comp in plan.slots:
+        r = await host.command(cmd_f(ch, slot, toff, window, comp))
+        assert r == b"K", f"F colour {ch} slot {slot}: {r!r}"
+    assert plan.sequence[:2] == (0, 3)
 
     # One frame: Q(0, 1).
     assert await host.command(cmd_q(0, 1, 1, False)) == b"K"
@@ -550,7 +522,7 @@ async def test_load_and_play(dut):
     assert nref > 0, "the controller never refreshed"
     dut._log.info(f"board top on SDRAM: {n_first} frames after Q(0,1) and {len(frames2)} "
                   f"after Q(0,3,2,loop) match the golden model, sequence {s_}; "
-                  f"{sum(len(m) for m, _ in packed)} words stored ({shared} shared); status "
+                  f"{stored} words stored, {blocks} line blocks; status "
                   f"{ferr}/{cerr}/{kerr} errors, {nfr} frames played; SDRAM {nerr} violations, "
                   f"{nref} refreshes; registers {dict((k, hex(v)) for k, v in regs.items())}")
 

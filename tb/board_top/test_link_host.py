@@ -1,14 +1,17 @@
 """The host tool fpga/ulx3s/de32_load.py against a simulated board: the pure-Python loader
 model fpga/ulx3s/loader_model.py (no cocotb) behind a pty, with injected errors.
 
-  * the model's protocol: replies, checksum / field errors, skipped garbage, counters;
+  * the model's protocol (loader version 2: X, F, Q, O, R, S): replies, checksum / field
+    errors, skipped garbage (the retired 'W'), counters;
   * a scene (three .de32 files) loaded in one command through a pty with a corrupted
-    byte inside a 'W' (NACKed 'E', re-sent) and a swallowed reply (timeout, re-sent):
-    every frame-store word, the descriptors and the output window equal the files;
+    byte inside an 'X' (NACKed 'E', re-sent) and a swallowed reply (timeout, re-sent):
+    every frame read back from the model's SDRAM regions through its slot's frame table
+    (frame_pack.read_back) equals the files; slots, sequence and output window;
   * a dropped link half-way: exit status 2, the state file names the last acknowledged
     packet, and --resume on a new link sends only the packets after it and completes;
   * a scene directory of .de48 streams plus an animation directory (frame000/ and a
-    YPD1 delta), --window / --round: every frame stored one after the other per colour;
+    YPD1 delta), --window / --round: every frame's slot reads back to its streams, the
+    lines the frames share are stored once, and --show plays one frame;
   * bad inputs name file and byte / slot / line; --help; the progress line.
 SEED=<n> replays the random words.
 """
@@ -30,7 +33,10 @@ sys.path.insert(0, str(ULX))
 sys.path.insert(0, str(HERE.parent.parent / "sw"))
 
 import de32_load as dl  # noqa: E402
+import frame_pack  # noqa: E402
 from loader_model import Device, Faults, LoaderModel  # noqa: E402
+
+MARKER = frame_pack.MARKER_WORD
 
 FAST = ["--abandon", "0.1"]          # the model abandons a partial command after 0.05 s
 
@@ -54,47 +60,79 @@ def write_de32(path: Path, words, window=2, comp=False) -> None:
                      + b"".join(struct.pack(">I", w) for w in words))
 
 
-def scene(tmp: Path, rng: random.Random, n=(700, 513, 260)) -> tuple[list[str], list]:
+def line_words(rng: random.Random, n: int, lines: int) -> list[int]:
+    """n random frame-store words in `lines` lines of about equal length, each ending
+    with the marker (no other word is a marker)."""
+    assert n >= lines
+    body = [w for w in (rng.randrange(1 << 32) for _ in range(2 * n))
+            if not frame_pack.is_marker(w)][:n - lines]
+    per, out = len(body) // lines, []
+    for y in range(lines):
+        out += body[y * per:(y + 1) * per if y < lines - 1 else len(body)] + [MARKER]
+    return out
+
+
+def scene(tmp: Path, rng: random.Random, n=(700, 513, 260), lines=12) -> tuple[list[str], list]:
     files, words = [], []
     for c, k in zip("rgb", n):
-        w = [rng.randrange(1 << 32) for _ in range(k)]
+        w = line_words(rng, k, lines)
         write_de32(tmp / f"{c}.de32", w, window=c == "g" and 3 or 1, comp=c == "r")
         files.append(str(tmp / f"{c}.de32"))
         words.append(w)
     return files, words
 
 
+def image(m: LoaderModel) -> dict[int, int]:
+    """The model's SDRAM regions as controller word addresses (frame_pack.addr)."""
+    return {frame_pack.addr(c, off): w for c in range(3) for off, w in m.mem[c].items()}
+
+
+def read_slot(m: LoaderModel, ch: int, slot: int, vactive: int) -> list[int]:
+    return frame_pack.read_back(image(m), ch, m.slots[ch][slot][0], vactive)
+
+
 # ---------------------------------------------------------------------- the model
 def test_model_protocol():
-    m = LoaderModel(fs_depth=64)
-    assert m.feed(dl.cmd_w(1, 3, [0x11223344, 0x55667788])) == b"K"
-    assert m.fs[1][3:5] == [0x11223344, 0x55667788]
-    bad = bytearray(dl.cmd_w(1, 3, [0xAAAAAAAA]))
+    m = LoaderModel()
+    R = 1 << 21
+    assert m.feed(dl.cmd_x(1, 3, [0x11223344, 0x55667788])) == b"K"
+    assert m.mem[1] == {3: 0x11223344, 4: 0x55667788}
+    bad = bytearray(dl.cmd_x(1, 3, [0xAAAAAAAA]))
     bad[-1] ^= 1
     assert m.feed(bytes(bad)) == b"E" and m.cerr == 1
-    assert m.fs[1][3] == 0xAAAAAAAA, "words are written as they arrive, like the RTL"
-    assert m.feed(dl.cmd_w(3, 0, [1])) == b"E"             # colour out of range
-    assert m.feed(dl.cmd_w(0, 63, [1, 2])) == b"E"         # runs off the frame store
-    assert m.feed(b"\x00\x01") == b"" and m.kerr == 4      # 2 fields + 2 garbage bytes
-    assert m.feed(dl.cmd_p(2, 5, 9, 4, True)) == b"K" and m.desc[2] == (5, 9, 4, True)
-    assert m.feed(dl.cmd_p(2, 5, 9, 5, True)) == b"E"      # window > 4
+    assert m.mem[1][3] == 0xAAAAAAAA, "words are written as they arrive, like the RTL"
+    assert m.feed(dl.cmd_x(3, 0, [1])) == b"E"             # colour out of range
+    assert m.feed(dl.cmd_x(0, R - 1, [1, 2])) == b"E"      # runs off the region
+    assert m.mem[0] == {R - 1: 1}
+    assert m.feed(dl.cmd_x(0, 0, [])) == b"E"              # no words
+    assert m.feed(b"\x00\x01") == b"" and m.kerr == 5      # 3 fields + 2 garbage bytes
+    assert m.feed(dl.with_chk(b"W\x00\x00\x00\x00\x00")) == b"" and m.kerr == 12  # retired
+    assert m.feed(dl.cmd_f(2, 5, 96, 4, True)) == b"K" and m.slots[2] == {5: (96, 4, True)}
+    for f in (dl.cmd_f(2, 5, 96, 5, True), dl.cmd_f(2, 64, 96, 0, False),
+              dl.cmd_f(2, 5, 97, 0, False), dl.cmd_f(2, 5, R, 0, False)):
+        assert m.feed(f) == b"E", f.hex()                   # window, slot, alignment, region
+    assert m.feed(dl.cmd_q(3, 61, 2, True)) == b"K" and m.sequence == (3, 61, 2, 1)
+    for q in (dl.cmd_q(3, 62, 2, True), dl.cmd_q(0, 0, 1, False), dl.cmd_q(0, 1, 0, False),
+              dl.with_chk(b"Q\x00\x01\x01\x02"), dl.cmd_q(64, 1, 1, False)):
+        assert m.feed(q) == b"E", q.hex()
     assert m.feed(dl.cmd_o(3, False)) == b"K" and m.out8 == (3, 0)
     m.regs[0x3000] = 0xDC310004
     assert m.feed(dl.with_chk(b"R\x30\x00")) == b"R\xdc\x31\x00\x04"
     s = m.feed(dl.with_chk(b"S"))
-    assert len(s) == 16 and s[:4] == b"S\x01\x01\x06"
-    assert struct.unpack(">HHH", s[4:10]) == (0, 1, 5) and s[13] == 3
-    assert m.feed(b"W\x00") == b"" and m.busy() and m.idle() == b"T" and not m.busy()
+    assert len(s) == 16 and s[:4] == b"S\x02\x01\x15"
+    assert struct.unpack(">HHH", s[4:10]) == (0, 1, 5 + 7 + 4 + 5) and s[13] == 3
+    assert s[14:] == b"\0\0"
+    assert m.feed(b"X\x00") == b"" and m.busy() and m.idle() == b"T" and not m.busy()
 
 
 # ---------------------------------------------------------------------- scene over a pty
 def test_scene_with_errors(tmp_path):
     rng = random.Random(seed())
     files, words = scene(tmp_path, rng)
-    m = LoaderModel(fs_depth=2048)
-    # 'S' is 2 bytes; the first 'W' (64 words) is 263: corrupt a data byte of the second
-    # 'W', swallow the reply to the fourth packet.
-    dev, path, slave = board(m, Faults(corrupt_rx={2 + 263 + 100}, drop_reply={4}))
+    m = LoaderModel()
+    # 'S' is 2 bytes; the first 'X' (64 words) is 264: corrupt a data byte of the second
+    # 'X', swallow the reply to the fourth packet.
+    dev, path, slave = board(m, Faults(corrupt_rx={2 + 264 + 100}, drop_reply={4}))
     st = tmp_path / "state.json"
     rc = dl.main([path, *files, "--words", "64", "--state", str(st), "--shift", "2",
                   *FAST])
@@ -103,21 +141,23 @@ def test_scene_with_errors(tmp_path):
     assert rc == 0
     assert m.cerr == 1, "the corrupted byte must fail the checksum"
     for c in range(3):
-        assert m.fs[c][:len(words[c])] == words[c], f"colour {c} differs"
-    assert m.desc == [(0, 700, 1, True), (0, 513, 3, False), (0, 260, 1, False)]
+        assert read_slot(m, c, 0, 12) == words[c], f"colour {c} differs"
+    assert [m.slots[c][0][1:] for c in range(3)] == [(1, True), (3, False), (1, False)]
+    assert m.sequence == (0, 1, 1, 0)
     assert m.out8 == (2, 1)
-    n_pkts = sum(-(-len(w) // 64) for w in words) + 4
+    plan = frame_pack.pack([[(words[c], 0, False) for c in range(3)]], 12)
+    n_x = sum(-(-len(w) // 64) for _, _, w in plan.writes)
     s = json.loads(st.read_text())
-    assert s["acked"] == s["packets"] == n_pkts
+    assert s["acked"] == s["packets"] == n_x + 3 + 2
     # Re-sends: the NACKed packet and the one whose reply was lost (both idempotent).
     assert dev.replies.count(b"E") == 1
-    assert m.writes == sum(len(w) for w in words) + 64 + 64
+    assert m.writes == sum(len(w) for _, _, w in plan.writes) + 64 + 64
 
 
 def test_dropped_link_and_resume(tmp_path, capsys):
     rng = random.Random(seed())
     files, words = scene(tmp_path, rng)
-    m = LoaderModel(fs_depth=2048)
+    m = LoaderModel()
     st = tmp_path / "state.json"
     args = [*files, "--words", "32", "--state", str(st), *FAST]
     dev, path, slave = board(m, Faults(drop_link_after=5000))
@@ -127,26 +167,29 @@ def test_dropped_link_and_resume(tmp_path, capsys):
     assert rc == 2 and dev.dropped
     assert "--resume" in capsys.readouterr().err
     acked = json.loads(st.read_text())["acked"]
-    sizes = [min(32, len(w) - k) for w in words for k in range(0, len(w), 32)]
+    plan = frame_pack.pack([[(words[c], 0, False) for c in range(3)]], 12)
+    sizes = [min(32, len(w) - k) for _, _, w in plan.writes for k in range(0, len(w), 32)]
     sent = 2                                    # the 'S' of the size check
     for k in range(acked):
-        sent += 7 + 4 * sizes[k]
-    assert 0 < acked and sent <= 5000 < sent + 7 + 4 * sizes[acked], (acked, sent)
+        sent += 8 + 4 * sizes[k]
+    assert 0 < acked and sent <= 5000 < sent + 8 + 4 * sizes[acked], (acked, sent)
     # Resume on a new link: the board kept its memory; only packets >= acked are sent.
     before = m.writes
     dev2, path2, slave2 = board(m)
     assert dl.main([path2, *args, "--resume"]) == 0
     dev2.stop()
     os.close(slave2)
-    total = sum(len(w) for w in words)
-    assert m.writes - before == total - sum(sizes[:acked])
+    # The interrupted 'X' is still open in the board: the new link's first 'S' (2 bytes)
+    # may complete one more of its words (at an address the resumed packets rewrite)
+    # before the board abandons it ('T', and the tool re-sends the 'S').
+    assert m.writes - before - (sum(sizes) - sum(sizes[:acked])) in (0, 1)
     for c in range(3):
-        assert m.fs[c][:len(words[c])] == words[c]
+        assert read_slot(m, c, 0, 12) == words[c]
     assert json.loads(st.read_text())["acked"] == json.loads(st.read_text())["packets"]
     # A finished load resumes to nothing; another load's state is refused with its file.
     dev3, path3, slave3 = board(m)
     assert dl.main([path3, *args, "--resume"]) == 0
-    assert dl.main([path3, *args, "--resume", "--base", "4"]) == 1
+    assert dl.main([path3, *args, "--resume", "--shift", "4"]) == 1
     dev3.stop()
     os.close(slave3)
     assert f"{st}:1: written for another load" in capsys.readouterr().err
@@ -183,7 +226,7 @@ def test_scene_dir_and_anim(tmp_path):
             d += struct.pack(">HI", y, len(words) // 6) + words
     (tmp_path / "anim" / "frame001.delta").write_bytes(bytes(d))
 
-    m = LoaderModel(fs_depth=4096)
+    m = LoaderModel()
     dev, path, slave = board(m)
     rc = dl.main([path, str(f0), "--anim", str(tmp_path / "anim"), "--window", str(w),
                   "--state", str(tmp_path / "s.json"), "--show", "2", *FAST])
@@ -193,21 +236,26 @@ def test_scene_dir_and_anim(tmp_path):
     frames = [lines, lines, [lines[0], [new[1].get(y, lines[1][y]) for y in range(h)],
                              [new[2].get(y, lines[2][y]) for y in range(h)]]]
     for c in range(3):
-        base = 0
         for f, fr in enumerate(frames):
             slots = binfmt.decode_de48(b"DE48\0\1\0\0" + b"".join(fr[c]))
             cmds = binfmt.deserialise(slots)
             want = binfmt.framestore_encode(cmds, w)
-            assert m.fs[c][base:base + len(want)] == want, f"frame {f} colour {c}"
-            if f == 2:
-                assert m.desc[c] == (base, len(want), w, False)
-            base += len(want)
+            assert read_slot(m, c, f, h) == want, f"frame {f} colour {c}"
+            assert m.slots[c][f][1:] == (w, False)
+        # Frames 0 and 1 are equal: one table; frame 2 stores only its changed line.
+        assert m.slots[c][0][0] == m.slots[c][1][0]
+    assert m.slots[0][2][0] == m.slots[0][0][0], "red did not change: its table is shared"
+    assert m.sequence == (2, 1, 1, 0), "--show 2 plays frame 2 alone"
+    used = [len(m.mem[c]) for c in range(3)]
+    per_frame = [sum(len(binfmt.framestore_encode(binfmt.deserialise(binfmt.decode_de48(
+        b"DE48\0\1\0\0" + b"".join(fr[c]))), w)) for fr in frames) for c in range(3)]
+    assert all(u < p for u, p in zip(used, per_frame)), (used, per_frame)
 
 
 # ---------------------------------------------------------------------- errors, help
-def test_bad_inputs_name_file(tmp_path, capsys):
+def test_bad_inputs_name_file(tmp_path, capsys, monkeypatch):
     rng = random.Random(seed())
-    files, _ = scene(tmp_path, rng, n=(4, 4, 4))
+    files, _ = scene(tmp_path, rng, n=(4, 4, 4), lines=2)
     Path(files[1]).write_bytes(Path(files[1]).read_bytes()[:-2])
     assert dl.main(["/nonexistent", *files]) == 1
     assert f"{files[1]}:byte 22: truncated" in capsys.readouterr().err
@@ -226,13 +274,24 @@ def test_bad_inputs_name_file(tmp_path, capsys):
     # A broken state file: its line.
     st = tmp_path / "st.json"
     st.write_text('{"plan": "x",\n "acked": }\n')
-    write_de32(Path(files[1]), [1, 2, 3])
-    m = LoaderModel(fs_depth=64)
+    write_de32(Path(files[1]), line_words(rng, 3, 2))
+    m = LoaderModel()
     dev, path, slave = board(m)
     assert dl.main([path, *files, "--state", str(st), "--resume", *FAST]) == 1
+    assert f"{st}:2:" in capsys.readouterr().err
+    # A colour with another number of lines: the packer's error names frame, colour, line.
+    write_de32(Path(files[2]), line_words(rng, 6, 3))
+    assert dl.main([path, *files, "--state", str(st), *FAST]) == 1
+    err = capsys.readouterr().err
+    assert "frame 0 colour b line 2" in err, err
+    # A board with the version-1 loader (block-RAM frame stores): refused, named.
+    write_de32(Path(files[2]), line_words(rng, 6, 2))
+    import loader_model
+    monkeypatch.setattr(loader_model, "VERSION", 1)
+    assert dl.main([path, *files, "--state", str(st), *FAST]) == 1
+    assert "loader version 1" in capsys.readouterr().err
     dev.stop()
     os.close(slave)
-    assert f"{st}:2:" in capsys.readouterr().err
 
 
 def test_help_and_progress(capsys):

@@ -66,9 +66,16 @@ def measure(words: int, per_packet: int, seed: int = 1) -> dict:
     sys.path.insert(0, str(ULX))
     import de32_load as dl
     from loader_model import Device, LoaderModel
+    import frame_pack
     rng = random.Random(seed)
-    frames = [[([rng.randrange(1 << 32) for _ in range(words)], 2, False)] * 3]
-    pkts, _ = dl.plan_packets(frames, 0, per_packet, 0, 0, True, None)
+    # Random frame-store words (no marker among them), an end-of-line marker every 640
+    # words: one frame, the same for the three colours, in the loader's 'X' packets.
+    body = [w ^ (1 << 31) if frame_pack.is_marker(w) else w
+            for w in (rng.randrange(1 << 32) for _ in range(words))]
+    body[639::640] = [frame_pack.MARKER_WORD] * len(body[639::640])
+    body[-1] = frame_pack.MARKER_WORD
+    frames = [[(body, 2, False)] * 3]
+    pkts, plan = dl.plan_packets(frames, per_packet, 0, True)
     nbytes = sum(len(p) for p in pkts)
 
     record.OUT.mkdir(parents=True, exist_ok=True)
@@ -89,7 +96,7 @@ def measure(words: int, per_packet: int, seed: int = 1) -> dict:
 
     # The host tool and the loader model (the model parses every byte in Python).
     master, slave = pty.openpty()
-    model = LoaderModel(fs_depth=max(1024, words))
+    model = LoaderModel()
     dev = Device(master, model)
     port = dl.Port(os.ttyname(slave))
     st = dl.State(state, dl.plan_hash(pkts), len(pkts))
@@ -99,7 +106,9 @@ def measure(words: int, per_packet: int, seed: int = 1) -> dict:
     dev.stop()
     os.close(port.fd)
     os.close(slave)
-    assert model.fs[0][:words] == frames[0][0][0], "the model did not receive the words"
+    img = {frame_pack.addr(c, o): w for c in range(3) for o, w in model.mem[c].items()}
+    assert frame_pack.read_back(img, 0, plan.slots[0][2], plan.vactive) == body, \
+        "the model did not receive the words"
     return {"words_per_colour": words, "packet_words": per_packet, "packets": len(pkts),
             "bytes": nbytes, "baseline_s": base_s, "echo_s": echo_s, "tool_s": tool_s,
             "baseline_kBps": nbytes / base_s / 1e3, "echo_kBps": nbytes / echo_s / 1e3,
