@@ -130,7 +130,7 @@ module de_board_core #(
   logic [NumCh-1:0][0:0]       wr_valid, wr_ready;
   logic [NumCh-1:0][0:0][47:0] wr_data;
 
-  /* verilator lint_off UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // init done: for waveforms and debugging only
   logic sd_init_done;
   /* verilator lint_on UNUSEDSIGNAL */
   logic [NumCh-1:0]       fr_valid, fr_ready, dc_late;

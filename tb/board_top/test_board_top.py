@@ -30,8 +30,11 @@ checks, exactly:
     out of step), in the order 0 0 1 1 2 2 0 0 1 1 ... (each hold frames, wrapping);
   * sync: DE runs of HActive, hsync HSync wide and HFp after DE, HTotal apart, frames of
     VActive lines; control tokens only in blanking, data symbols only in DE;
+  * a frame with malformed lines (an early marker, a block not ending with one): shown
+    as the player fixes it (early marker dropped, last word made the marker), counted
+    in the status (2 per frame), every frame still VActive lines;
   * the loader's replies, the status (version 2, region 2^21 words; framing, checksum,
-    command errors exactly as injected; no malformed line, no late word), the controller
+    command errors exactly as injected; no late line for want of data), the controller
     ID and the Load Monitors' late-line and dropped-word totals (0) read over the UART;
   * the SDRAM model saw 0 timing violations and the controller refreshed.
 Parametrised runs: plain (78.125 MHz / 3 Mbaud, divider error 0.16 %), nearlimit
@@ -494,6 +497,32 @@ async def test_load_and_play(dut):
     assert cycle.startswith(rest), f"sequence {s_}: after the 0s, not 1 1 2 2 0 0 ..."
     assert len(rest) >= 8, f"sequence {s_}: no wrap seen (too few frames)"
 
+    # Malformed lines in colour R's slot 3 (G and B show frame 0): line 0's block is two
+    # markers (the early one is dropped), line 1's block is line 0 of frame 0 whose last
+    # word is not a marker (it is replaced by one), lines 2.. are empty. The player fixes
+    # both, counts them, and the frame stays VActive lines long.
+    l0 = split_lines(fw[0][0])[0]
+    t0 = stats[0]["words_used"]
+    b2 = t0 + 4
+    tbl = b2 + -(-len(l0) // 4) * 4
+    ents = [2 << 20 | t0 // 4, len(l0) << 20 | b2 // 4] + [0] * (va - 2)
+    for off, ws in ((t0, [MARKER, MARKER]), (b2, l0[:-1] + [0]), (tbl, ents)):
+        assert await host.command(cmd_x(0, off, ws)) == b"K"
+    for ch in range(NCH):
+        r = await host.command(cmd_f(ch, 3, tbl if ch == 0 else plan.tables[0][ch],
+                                     windows[ch], comps[ch]))
+        assert r == b"K"
+    assert await host.command(cmd_q(3, 1, 1, False)) == b"K"
+    n_before = len(video.frames())
+    await ClockCycles(dut.clk_i, 16 * ftime)
+    fixed = [MARKER] + l0 + [MARKER] * (va - 2)       # l0 ends with its marker
+    mal_img = [golden(binfmt.encode_de32(fixed, windows[0], comps[0]), g, shift, sat)] + \
+        imgs[0][1:]
+    frames3 = video.frames()[n_before:]
+    n_mal = sum(1 for f in frames3 if frame_index(f, [mal_img]) == [0])
+    assert n_mal >= 4 and frame_index(frames3[-1], [mal_img]) == [0], (
+        f"the fixed malformed frame is shown in {n_mal} of {len(frames3)} frames")
+
     # Status and registers over the UART.
     n_video = len(video.frames())       # frames shown before the status request
     st = await host.command(with_chk(b"S"), n_reply=16)
@@ -504,7 +533,9 @@ async def test_load_and_play(dut):
         f"error counters framing/checksum/command = {ferr}/{cerr}/{kerr}, want 1/2/2")
     assert st[12] == 0, f"flags {st[12]:#x}: align_err / collision / pending set"
     assert st[13] == (int(sat) << 3 | shift)
-    assert st[14] == 0 and st[15] == 0, f"malformed lines {st[14]}, late words {st[15]}"
+    # Two malformed lines per fetched frame of slot 3 (fetched >= shown), none before.
+    assert st[14] >= 2 * n_mal and st[14] % 2 == 0, f"malformed lines {st[14]}, {n_mal} shown"
+    assert st[15] == 0, f"late lines for want of SDRAM data: {st[15]}"
     assert nfr >= n_video, f"player frames {nfr} < displayed {n_video}"
     regs = {}
     for name, addr in [("id", 0x3000)] + [(f"late{c}", c << 12 | 0x00A) for c in range(NCH)] \
