@@ -403,7 +403,7 @@ def array_text(rep: dict, keys: list[str]) -> str:
 
 # --------------------------------------------------------------------------- seeds
 ULX3S = FPGA / "ulx3s"
-BOARD_OUT = "build/c72_d16384_span"   # fpga/ulx3s/Makefile's OUT for its defaults
+BOARD_OUT = "build/c72_sdram_p2048_span"   # fpga/ulx3s/Makefile's OUT for its defaults
 
 
 def seeds(args) -> int:

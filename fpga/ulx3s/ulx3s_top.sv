@@ -22,7 +22,7 @@
 // comes from the board oscillator with integer dividers; 25.175 MHz would need a
 // reference divider above 8 (PFD below the ECP5's 3.125 MHz minimum).
 //
-// The core's parameters (NumChips, FsDepth; the UART keeps the core defaults UartClkHz
+// The core's parameters (NumChips, PfDepth; the UART keeps the core defaults UartClkHz
 // 78.125 MHz = clk_core, Baud 3,000,000: 26 clocks per bit, docs/board.md §3) are set
 // by the Makefile when read_slang elaborates de_board_core; this file is read by yosys'
 // own parser (it needs the ECP5 primitives' parameters), so it passes none.
