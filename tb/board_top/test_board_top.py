@@ -553,7 +553,8 @@ async def test_load_and_play(dut):
     assert nref > 0, "the controller never refreshed"
     dut._log.info(f"board top on SDRAM: {n_first} frames after Q(0,1) and {len(frames2)} "
                   f"after Q(0,3,2,loop) match the golden model, sequence {s_}; "
-                  f"{stored} words stored, {blocks} line blocks; status "
+                  f"{stored} words stored, {blocks} line blocks; malformed frame shown "
+                  f"{n_mal} times, {st[14]} malformed lines counted; status "
                   f"{ferr}/{cerr}/{kerr} errors, {nfr} frames played; SDRAM {nerr} violations, "
                   f"{nref} refreshes; registers {dict((k, hex(v)) for k, v in regs.items())}")
 
