@@ -15,8 +15,9 @@
 // frames live in SDRAM as tables of lines (docs/sdram-frames-spec.md); per colour a
 // fetcher, a 2,048-word dual-clock prefetch FIFO, a player and an instruction buffer
 // (the display controller's one-buffer-per-colour choice, docs/display-controller.md
-// §9.1); each player is the single y-processor of its colour. TMDS channel 0 is blue and carries {VSYNC, HSYNC} as {C1, C0} while
-// blanking, channel 1 green, channel 2 red (DVI 1.0 §3.1).
+// §9.1); each player is the single y-processor of its colour. TMDS channel 0 is blue
+// and carries {VSYNC, HSYNC} as {C1, C0} while blanking, channel 1 green, channel 2 red
+// (DVI 1.0 §3.1).
 `default_nettype none
 
 module de_board_core #(

@@ -415,7 +415,7 @@ module de_sdram_frames #(
   assign frame_o = frame[0];
   assign late_o  = late_q;
 
-  /* verilator lint_off UNUSEDSIGNAL */  // prefetch ready: credit makes it always true; G/B frame pulses
+  /* verilator lint_off UNUSEDSIGNAL */  // FIFO ready (credit), G/B frame pulses
   logic unused;
   assign unused = ^{pf_ready, frame[2:1]};
   /* verilator lint_on UNUSEDSIGNAL */

@@ -159,6 +159,12 @@ async def test_model_equals_rtl(dut):
         assert rtl_seq[0] == model.sequence, f"step {step} ({what}): sequences differ"
     assert int(dut.out8_shift_o.value) == model.out8[0]
     assert int(dut.out8_sat_o.value) == model.out8[1]
+    # A flipped length field can leave a command open across the last steps: let both
+    # abandon it ('T') before the final status request.
+    await ClockCycles(dut.clk_i, tmo + 8)
+    want_tx += model.idle()
+    await ClockCycles(dut.clk_i, 40)
+    assert bytes(rtl_tx) == bytes(want_tx), "the final abandon differs"
     st = model.feed(dl.with_chk(b"S"))
     await byte(0x53)
     await byte(0xAD)
