@@ -4,7 +4,7 @@
 // FIFO (de_async_fifo, to the pixel clock), each word with the frame's window and
 // compensation flag ({comp, window[2:0], word[31:0]}).
 //
-// Issue side (one action per clock):
+// Issue side:
 //   * at a frame boundary it waits (frame_wait_o) until the sequencer starts the next
 //     frame (frame_go_i, with the slot's table offset, window, flag, or no slot: a black
 //     frame of VActive empty lines);
@@ -14,7 +14,13 @@
 //     own, no SDRAM read); else ceil(len / 4) block bursts from blk * 4, each only while
 //     the prefetch FIFO has room for 4 more words beyond every word reserved (credit:
 //     wfree_i is conservative, the reservations are exact), so it never overflows.
-//   The issue side is done with a frame when it has taken VActive lines.
+//   A burst is decided a clock ahead into the request register (req_*_o come from
+//   flip-flops, so the arbiter's choice is the only logic between here and the
+//   controller's input register); its words and entries are reserved when it is decided,
+//   its info entry is written when it is granted. A new request is decided only when the
+//   register is empty (one idle clock per burst of this colour, while the controller
+//   takes a burst every 8 clocks at most). The issue side is done with a frame when it
+//   has taken VActive lines and its last request is granted.
 // Return side: the controller answers requests in order (rd_valid_i: this colour's tag);
 // an info FIFO remembers what each request (and each padding marker, to keep it in order)
 // is. Table words go to the entry FIFO; block words to the prefetch FIFO, except the
@@ -26,7 +32,7 @@
 
 module de_frame_fetch #(
   parameter int unsigned PfDepth   = 2048,   // the prefetch FIFO's entries
-  parameter int unsigned InfoDepth = 4,      // requests (and pads) in flight
+  parameter int unsigned InfoDepth = 8,      // requests (and pads) in flight
   parameter int unsigned EntDepth  = 8,      // table entries buffered
   localparam int unsigned PW = $clog2(PfDepth)
 ) (
@@ -57,8 +63,8 @@ module de_frame_fetch #(
   if (PfDepth < 16 || (PfDepth & (PfDepth - 1)) != 0) begin : g_bad_pf
     $fatal(1, "de_frame_fetch: PfDepth must be a power of two >= 16");
   end
-  if (InfoDepth < 2 || (InfoDepth & (InfoDepth - 1)) != 0) begin : g_bad_info
-    $fatal(1, "de_frame_fetch: InfoDepth must be a power of two >= 2");
+  if (InfoDepth < 4 || (InfoDepth & (InfoDepth - 1)) != 0) begin : g_bad_info
+    $fatal(1, "de_frame_fetch: InfoDepth must be a power of two >= 4");
   end
   if (EntDepth < 8 || (EntDepth & (EntDepth - 1)) != 0) begin : g_bad_ent
     $fatal(1, "de_frame_fetch: EntDepth must be a power of two >= 8");
@@ -93,6 +99,10 @@ module de_frame_fetch #(
   logic [EW:0]   ent_resv_d, ent_resv_q;  // table entries requested, not yet returned
   logic          mal_line_d, mal_line_q;
   logic [1:0]    widx_d, widx_q;
+  // The request register: a burst decided, waiting for its grant.
+  logic          rq_v_d, rq_v_q;
+  logic [20:0]   rq_off_d, rq_off_q;
+  info_t         rq_info_d, rq_info_q;
 
   info_t         info_q [InfoDepth];
   logic [IW-1:0] info_wp_q, info_rp_q;
@@ -102,38 +112,38 @@ module de_frame_fetch #(
   logic [EW:0]   ent_cnt_q;
 
   // ---------------------------------------------------------------- issue side
-  logic        info_room, credit4, credit1, tbl_req, blk_req, grant_tbl, grant_blk;
-  logic        take_ok, take, take_pad, ent_pop;
+  logic        info_room, credit4, credit1, dec_tbl, dec_blk, grant;
+  logic        take_ok, take, take_pad, ent_pop, pad_ok;
   /* verilator lint_off UNUSEDSIGNAL */
   logic [31:0] ent_head;      // bit 19 unused (below)
   /* verilator lint_on UNUSEDSIGNAL */
   logic [11:0] tbl_left;
-  info_t       info_new;
   logic        info_push;
+  info_t       info_new;
 
   // An entry is {len[11:0], blk[19:0]}; blk < 2^19 in a 2^21-word region, so blk[19]
   // is not used (the block address wraps in the region).
-  assign ent_head = ent_q[ent_rp_q];
+  assign ent_head  = ent_q[ent_rp_q];
   assign tbl_left  = vactive_i - tbl_req_q;
-  assign info_room = info_cnt_q != (IW + 1)'(InfoDepth);
+  // Room for the decided request and the one in the register when it is granted.
+  assign info_room = info_cnt_q <= (IW + 1)'(InfoDepth - 2);
   assign credit4   = (resv_q + (PW + 2)'(4)) <= (PW + 2)'(pf_free_i);
   assign credit1   = (resv_q + (PW + 2)'(1)) <= (PW + 2)'(pf_free_i);
-  assign tbl_req   = in_frame_q && fvalid_q && (tbl_req_q < vactive_i) && info_room &&
-                     ((ent_cnt_q + ent_resv_q) <= (EW + 1)'(EntDepth - 4));
-  assign blk_req   = in_frame_q && line_act_q && info_room && credit4;
-  assign req_valid_o = tbl_req || blk_req;
-  assign req_off_o   = tbl_req ? ftbl_q + 21'(tbl_req_q) : line_addr_q;
-  assign grant_tbl   = req_grant_i && tbl_req;
-  assign grant_blk   = req_grant_i && !tbl_req && blk_req;
+  // Decide a burst into the empty request register: the table first.
+  assign dec_tbl   = in_frame_q && !rq_v_q && fvalid_q && (tbl_req_q < vactive_i) &&
+                     info_room && ((ent_cnt_q + ent_resv_q) <= (EW + 1)'(EntDepth - 4));
+  assign dec_blk   = in_frame_q && !rq_v_q && !dec_tbl && line_act_q && info_room && credit4;
+  assign grant     = req_grant_i && rq_v_q;
+  assign req_valid_o = rq_v_q;
+  assign req_off_o   = rq_off_q;
 
-  // Take the next line (an entry, or an empty line of a black frame) in a clock without
-  // a grant (both would push the info FIFO). A padding marker waits until nothing is in
-  // flight: then it is at the head of the info FIFO at once and leaves in the next clock,
-  // before any later request's data can arrive (so a pad never holds up a read word,
-  // which has no back-pressure); one pad per 2 clocks.
-  logic pad_ok;
-  assign pad_ok   = (info_cnt_q == '0) && credit1;
-  assign take_ok  = in_frame_q && !line_act_q && (lines_q < vactive_i) && !req_grant_i;
+  // Take the next line (an entry, or an empty line of a black frame). A padding marker
+  // waits until nothing is in flight or waiting (then no grant can push the info FIFO in
+  // the same clock): it is at the head of the info FIFO at once and leaves in the next
+  // clock, before any later request's data can arrive, so a pad never holds up a read
+  // word (which has no back-pressure); one pad per 2 clocks.
+  assign pad_ok   = (info_cnt_q == '0) && !rq_v_q && credit1;
+  assign take_ok  = in_frame_q && !line_act_q && (lines_q < vactive_i);
   always_comb begin
     take     = 1'b0;
     take_pad = 1'b0;
@@ -154,17 +164,23 @@ module de_frame_fetch #(
   end
 
   always_comb begin
-    info_push = grant_tbl || grant_blk || take_pad;
-    info_new  = '{kind: KPad, nval: 3'd1, last: 1'b1, win: fwin_q, comp: fcomp_q};
-    if (grant_tbl) begin
-      info_new.kind = KTable;
-      info_new.nval = (tbl_left >= 12'd4) ? 3'd4 : 3'(tbl_left);
-      info_new.last = 1'b0;
-    end else if (grant_blk) begin
-      info_new.kind = KBlock;
-      info_new.nval = (line_left_q >= 12'd4) ? 3'd4 : 3'(line_left_q);
-      info_new.last = (line_left_q <= 12'd4);
+    rq_v_d    = rq_v_q && !grant;
+    rq_off_d  = rq_off_q;
+    rq_info_d = rq_info_q;
+    if (dec_tbl) begin
+      rq_v_d    = 1'b1;
+      rq_off_d  = ftbl_q + 21'(tbl_req_q);
+      rq_info_d = '{kind: KTable, nval: (tbl_left >= 12'd4) ? 3'd4 : 3'(tbl_left),
+                    last: 1'b0, win: fwin_q, comp: fcomp_q};
+    end else if (dec_blk) begin
+      rq_v_d    = 1'b1;
+      rq_off_d  = line_addr_q;
+      rq_info_d = '{kind: KBlock, nval: (line_left_q >= 12'd4) ? 3'd4 : 3'(line_left_q),
+                    last: (line_left_q <= 12'd4), win: fwin_q, comp: fcomp_q};
     end
+    info_push = grant || take_pad;
+    info_new  = grant ? rq_info_q :
+                '{kind: KPad, nval: 3'd1, last: 1'b1, win: fwin_q, comp: fcomp_q};
   end
 
   // ---------------------------------------------------------------- return side
@@ -246,8 +262,8 @@ module de_frame_fetch #(
         line_act_d = 1'b0;
       end
     end else begin
-      if (grant_tbl) tbl_req_d = tbl_req_q + 12'd4;
-      if (grant_blk) begin
+      if (dec_tbl) tbl_req_d = tbl_req_q + 12'd4;
+      if (dec_blk) begin
         line_addr_d = line_addr_q + 21'd4;
         line_left_d = (line_left_q >= 12'd4) ? line_left_q - 12'd4 : 12'd0;
         line_act_d  = (line_left_q > 12'd4);
@@ -260,12 +276,12 @@ module de_frame_fetch #(
           line_left_d = ent_head[31:20];
         end
       end
-      if (!line_act_q && lines_q >= vactive_i) in_frame_d = 1'b0;
+      if (!line_act_q && lines_q >= vactive_i && !rq_v_q) in_frame_d = 1'b0;
     end
 
-    resv_d = resv_q + (grant_blk ? (PW + 2)'(4) : '0) + (PW + 2)'(take_pad)
+    resv_d = resv_q + (dec_blk ? (PW + 2)'(4) : '0) + (PW + 2)'(take_pad)
              - (PW + 2)'(resv_dec);
-    ent_resv_d = ent_resv_q + (grant_tbl ? (EW + 1)'(4) : '0) - (EW + 1)'(ent_resv_dec);
+    ent_resv_d = ent_resv_q + (dec_tbl ? (EW + 1)'(4) : '0) - (EW + 1)'(ent_resv_dec);
   end
 
   always_ff @(posedge clk_i) begin
@@ -289,6 +305,9 @@ module de_frame_fetch #(
       ent_resv_q  <= '0;
       mal_line_q  <= 1'b0;
       widx_q      <= 2'd0;
+      rq_v_q      <= 1'b0;
+      rq_off_q    <= '0;
+      rq_info_q   <= '{kind: KPad, nval: 3'd1, last: 1'b0, win: 3'd0, comp: 1'b0};
       info_wp_q   <= '0;
       info_rp_q   <= '0;
       info_cnt_q  <= '0;
@@ -310,6 +329,9 @@ module de_frame_fetch #(
       ent_resv_q  <= ent_resv_d;
       mal_line_q  <= mal_line_d;
       widx_q      <= widx_d;
+      rq_v_q      <= rq_v_d;
+      rq_off_q    <= rq_off_d;
+      rq_info_q   <= rq_info_d;
       if (info_push) info_wp_q <= info_wp_q + 1'b1;
       if (info_pop)  info_rp_q <= info_rp_q + 1'b1;
       info_cnt_q  <= info_cnt_q + (IW + 1)'(info_push) - (IW + 1)'(info_pop);
