@@ -91,7 +91,12 @@ module de_frame_fetch #(
   logic        in_frame_d, in_frame_q, fvalid_d, fvalid_q, fcomp_d, fcomp_q;
   logic [20:0] ftbl_d, ftbl_q;
   logic [2:0]  fwin_d, fwin_q;
-  logic [11:0] tbl_req_d, tbl_req_q, lines_d, lines_q;
+  logic [11:0] tbl_req_d, tbl_req_q;
+  // Down-counters, so the decisions test a zero instead of comparing with VActive.
+  logic [11:0] tbl_left_d, tbl_left_q, lines_left_d, lines_left_q;
+  // Credit flags, registered with a margin (below).
+  logic        credit4_d, credit4_q, credit1_d, credit1_q;
+  logic [EW:0] ent_space_d, ent_space_q;   // entry FIFO room minus entries in flight
   logic        line_act_d, line_act_q;
   logic [20:0] line_addr_d, line_addr_q;
   logic [11:0] line_left_d, line_left_q;
@@ -117,21 +122,25 @@ module de_frame_fetch #(
   /* verilator lint_off UNUSEDSIGNAL */
   logic [31:0] ent_head;      // bit 19 unused (below)
   /* verilator lint_on UNUSEDSIGNAL */
-  logic [11:0] tbl_left;
   logic        info_push;
   info_t       info_new;
 
   // An entry is {len[11:0], blk[19:0]}; blk < 2^19 in a 2^21-word region, so blk[19]
   // is not used (the block address wraps in the region).
   assign ent_head  = ent_q[ent_rp_q];
-  assign tbl_left  = vactive_i - tbl_req_q;
   // Room for the decided request and the one in the register when it is granted.
   assign info_room = info_cnt_q <= (IW + 1)'(InfoDepth - 2);
-  assign credit4   = (resv_q + (PW + 2)'(4)) <= (PW + 2)'(pf_free_i);
-  assign credit1   = (resv_q + (PW + 2)'(1)) <= (PW + 2)'(pf_free_i);
+  // Credit, registered: computed from this clock's reservations and free count with a
+  // margin of 4, it still holds a clock later, because meanwhile the free count falls
+  // only by words that were reserved, and at most one burst (4 words) or one pad is
+  // reserved per clock.
+  assign credit4   = credit4_q;
+  assign credit1   = credit1_q;
+  assign credit4_d = (resv_q + (PW + 2)'(8)) <= (PW + 2)'(pf_free_i);
+  assign credit1_d = (resv_q + (PW + 2)'(5)) <= (PW + 2)'(pf_free_i);
   // Decide a burst into the empty request register: the table first.
-  assign dec_tbl   = in_frame_q && !rq_v_q && fvalid_q && (tbl_req_q < vactive_i) &&
-                     info_room && ((ent_cnt_q + ent_resv_q) <= (EW + 1)'(EntDepth - 4));
+  assign dec_tbl   = in_frame_q && !rq_v_q && fvalid_q && (tbl_left_q != 12'd0) &&
+                     info_room && (ent_space_q >= (EW + 1)'(4));
   assign dec_blk   = in_frame_q && !rq_v_q && !dec_tbl && line_act_q && info_room && credit4;
   assign grant     = req_grant_i && rq_v_q;
   assign req_valid_o = rq_v_q;
@@ -143,7 +152,7 @@ module de_frame_fetch #(
   // clock, before any later request's data can arrive, so a pad never holds up a read
   // word (which has no back-pressure); one pad per 2 clocks.
   assign pad_ok   = (info_cnt_q == '0) && !rq_v_q && credit1;
-  assign take_ok  = in_frame_q && !line_act_q && (lines_q < vactive_i);
+  assign take_ok  = in_frame_q && !line_act_q && (lines_left_q != 12'd0);
   always_comb begin
     take     = 1'b0;
     take_pad = 1'b0;
@@ -170,7 +179,7 @@ module de_frame_fetch #(
     if (dec_tbl) begin
       rq_v_d    = 1'b1;
       rq_off_d  = ftbl_q + 21'(tbl_req_q);
-      rq_info_d = '{kind: KTable, nval: (tbl_left >= 12'd4) ? 3'd4 : 3'(tbl_left),
+      rq_info_d = '{kind: KTable, nval: (tbl_left_q >= 12'd4) ? 3'd4 : 3'(tbl_left_q),
                     last: 1'b0, win: fwin_q, comp: fcomp_q};
     end else if (dec_blk) begin
       rq_v_d    = 1'b1;
@@ -244,8 +253,9 @@ module de_frame_fetch #(
     ftbl_d      = ftbl_q;
     fwin_d      = fwin_q;
     fcomp_d     = fcomp_q;
-    tbl_req_d   = tbl_req_q;
-    lines_d     = lines_q;
+    tbl_req_d    = tbl_req_q;
+    tbl_left_d   = tbl_left_q;
+    lines_left_d = lines_left_q;
     line_act_d  = line_act_q;
     line_addr_d = line_addr_q;
     line_left_d = line_left_q;
@@ -257,31 +267,39 @@ module de_frame_fetch #(
         ftbl_d     = {table4_i, 2'b00};
         fwin_d     = window_i;
         fcomp_d    = comp_i;
-        tbl_req_d  = 12'd0;
-        lines_d    = 12'd0;
-        line_act_d = 1'b0;
+        tbl_req_d    = 12'd0;
+        tbl_left_d   = vactive_i;
+        lines_left_d = vactive_i;
+        line_act_d   = 1'b0;
       end
     end else begin
-      if (dec_tbl) tbl_req_d = tbl_req_q + 12'd4;
+      if (dec_tbl) begin
+        tbl_req_d  = tbl_req_q + 12'd4;
+        tbl_left_d = (tbl_left_q >= 12'd4) ? tbl_left_q - 12'd4 : 12'd0;
+      end
       if (dec_blk) begin
         line_addr_d = line_addr_q + 21'd4;
         line_left_d = (line_left_q >= 12'd4) ? line_left_q - 12'd4 : 12'd0;
         line_act_d  = (line_left_q > 12'd4);
       end
       if (take) begin
-        lines_d = lines_q + 12'd1;
+        lines_left_d = lines_left_q - 12'd1;
         if (fvalid_q && !take_pad) begin
           line_act_d  = 1'b1;
           line_addr_d = {ent_head[18:0], 2'b00};
           line_left_d = ent_head[31:20];
         end
       end
-      if (!line_act_q && lines_q >= vactive_i && !rq_v_q) in_frame_d = 1'b0;
+      if (!line_act_q && lines_left_q == 12'd0 && !rq_v_q) in_frame_d = 1'b0;
     end
 
     resv_d = resv_q + (dec_blk ? (PW + 2)'(4) : '0) + (PW + 2)'(take_pad)
              - (PW + 2)'(resv_dec);
     ent_resv_d = ent_resv_q + (dec_tbl ? (EW + 1)'(4) : '0) - (EW + 1)'(ent_resv_dec);
+    // Room in the entry FIFO beyond the entries in flight: a table burst takes 4, a
+    // popped entry gives 1 back, a returned word past the table's end gives its 1 back.
+    ent_space_d = ent_space_q - (dec_tbl ? (EW + 1)'(4) : '0) + (EW + 1)'(ent_pop)
+                  + (EW + 1)'(ent_resv_dec && !ent_push);
   end
 
   always_ff @(posedge clk_i) begin
@@ -297,7 +315,11 @@ module de_frame_fetch #(
       fwin_q      <= 3'd0;
       fcomp_q     <= 1'b0;
       tbl_req_q   <= 12'd0;
-      lines_q     <= 12'd0;
+      tbl_left_q  <= 12'd0;
+      lines_left_q <= 12'd0;
+      credit4_q   <= 1'b0;
+      credit1_q   <= 1'b0;
+      ent_space_q <= (EW + 1)'(EntDepth);
       line_act_q  <= 1'b0;
       line_addr_q <= '0;
       line_left_q <= 12'd0;
@@ -321,7 +343,11 @@ module de_frame_fetch #(
       fwin_q      <= fwin_d;
       fcomp_q     <= fcomp_d;
       tbl_req_q   <= tbl_req_d;
-      lines_q     <= lines_d;
+      tbl_left_q  <= tbl_left_d;
+      lines_left_q <= lines_left_d;
+      credit4_q   <= credit4_d;
+      credit1_q   <= credit1_d;
+      ent_space_q <= ent_space_d;
       line_act_q  <= line_act_d;
       line_addr_q <= line_addr_d;
       line_left_q <= line_left_d;
