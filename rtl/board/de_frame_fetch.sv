@@ -136,8 +136,10 @@ module de_frame_fetch #(
   // reserved per clock.
   assign credit4   = credit4_q;
   assign credit1   = credit1_q;
-  assign credit4_d = (resv_q + (PW + 2)'(8)) <= (PW + 2)'(pf_free_i);
-  assign credit1_d = (resv_q + (PW + 2)'(5)) <= (PW + 2)'(pf_free_i);
+  // One more word of margin: a word leaves the reservations a clock before it reaches
+  // the FIFO (the registered push below), so the free count may not show it yet.
+  assign credit4_d = (resv_q + (PW + 2)'(9)) <= (PW + 2)'(pf_free_i);
+  assign credit1_d = (resv_q + (PW + 2)'(6)) <= (PW + 2)'(pf_free_i);
   // Decide a burst into the empty request register: the table first.
   assign dec_tbl   = in_frame_q && !rq_v_q && fvalid_q && (tbl_left_q != 12'd0) &&
                      info_room && (ent_space_q >= (EW + 1)'(4));
@@ -368,8 +370,17 @@ module de_frame_fetch #(
   end
 
   assign frame_wait_o = !in_frame_q;
-  assign pf_push_o    = pf_push;
-  assign pf_data_o    = {head.comp, head.win, pf_word};
+  // The push to the prefetch FIFO is registered (the info FIFO's read, the marker test
+  // and the FIFO's pointer arithmetic are then in different clocks).
+  logic        pf_push_q;
+  logic [35:0] pf_data_q;
+  always_ff @(posedge clk_i) begin
+    if (rst_i) pf_push_q <= 1'b0;
+    else       pf_push_q <= pf_push;
+    pf_data_q <= {head.comp, head.win, pf_word};
+  end
+  assign pf_push_o    = pf_push_q;
+  assign pf_data_o    = pf_data_q;
   assign malformed_o  = malformed;
 endmodule
 

@@ -19,7 +19,7 @@
 // count, hold, loop) is one for all three colours. The sequencer is a barrier: when all
 // three fetchers are at a frame boundary it picks the frame's slot (a pending Q replaces
 // the sequence here, so a switch happens only at a frame boundary), reads the three
-// colours' slots and starts all three together. So the colours fetch the same frame
+// colours' slots and starts all three together, three clocks later. So the colours fetch the same frame
 // number from the same sequence position: they stay in lockstep, and since every fetched
 // frame is played in order (exactly VActive markers each), a slot is shown for exactly
 // `hold` displayed frames. Before any Q, and after reset, the frames are black.
@@ -145,50 +145,67 @@ module de_sdram_frames #(
     logic       loop;
   } seq_t;
 
+  // Three steps per frame boundary, each on flip-flops (a boundary comes at most once
+  // per VActive lines): A, all three fetchers wait: a pending Q becomes the sequence;
+  // B, the frame's slot (first + idx) and the advance flags; C, the slots are read and
+  // all three fetchers start (go), and the position moves on for the next frame.
+  typedef enum logic [1:0] {QIdle, QSel, QGo} qstate_e;
+
+  qstate_e    qs_d, qs_q;
   seq_t       seq_d, seq_q, pend_d, pend_q;
   logic       seq_v_d, seq_v_q, pend_v_d, pend_v_q;
   logic [6:0] idx_d, idx_q;
   logic [7:0] hc_d, hc_q;
-  logic       sel_d, sel_q, use_d, use_q;
+  logic       use_d, use_q, hold_done_d, hold_done_q, last_d, last_q;
   logic [5:0] slot_sel_d;
   logic [NumCh-1:0] f_wait;
   logic       go;
-  seq_t       ns;
-  logic [6:0] nidx;
-  logic [7:0] nhc;
 
-  assign go = sel_q;   // stage B: the slots of slot_sel_q are read, all three start
+  assign go = (qs_q == QGo);
 
   always_comb begin
-    seq_d      = seq_q;
-    seq_v_d    = seq_v_q;
-    pend_d     = pend_q;
-    pend_v_d   = pend_v_q;
-    idx_d      = idx_q;
-    hc_d       = hc_q;
-    sel_d      = 1'b0;
-    use_d      = use_q;
-    slot_sel_d = slot_sel_q;
-    ns         = pend_v_q ? pend_q : seq_q;
-    nidx       = pend_v_q ? 7'd0 : idx_q;
-    nhc        = pend_v_q ? 8'd0 : hc_q;
-    // Stage A: every colour at its frame boundary: this frame's slot, then the position
-    // of the next frame.
-    if (&f_wait && !sel_q) begin
-      sel_d      = 1'b1;
-      use_d      = seq_v_q || pend_v_q;
-      slot_sel_d = ns.first + 6'(nidx);
-      seq_d      = ns;
-      seq_v_d    = seq_v_q || pend_v_q;
-      pend_v_d   = 1'b0;
-      if (nhc + 8'd1 >= ns.hold) begin
-        hc_d  = 8'd0;
-        idx_d = (nidx + 7'd1 < ns.count) ? nidx + 7'd1 : (ns.loop ? 7'd0 : nidx);
-      end else begin
-        hc_d  = nhc + 8'd1;
-        idx_d = nidx;
+    qs_d        = qs_q;
+    seq_d       = seq_q;
+    seq_v_d     = seq_v_q;
+    pend_d      = pend_q;
+    pend_v_d    = pend_v_q;
+    idx_d       = idx_q;
+    hc_d        = hc_q;
+    use_d       = use_q;
+    slot_sel_d  = slot_sel_q;
+    hold_done_d = hold_done_q;
+    last_d      = last_q;
+    unique case (qs_q)
+      QIdle: begin
+        if (&f_wait) begin
+          qs_d = QSel;
+          if (pend_v_q) begin
+            seq_d    = pend_q;
+            seq_v_d  = 1'b1;
+            pend_v_d = 1'b0;
+            idx_d    = 7'd0;
+            hc_d     = 8'd0;
+          end
+        end
       end
-    end
+      QSel: begin
+        qs_d        = QGo;
+        use_d       = seq_v_q;
+        slot_sel_d  = seq_q.first + 6'(idx_q);
+        hold_done_d = (9'(hc_q) + 9'd1 >= 9'(seq_q.hold));
+        last_d      = (8'(idx_q) + 8'd1 >= 8'(seq_q.count));
+      end
+      QGo: begin
+        qs_d = QIdle;
+        if (hold_done_q) begin
+          hc_d  = 8'd0;
+          idx_d = last_q ? (seq_q.loop ? 7'd0 : idx_q) : idx_q + 7'd1;
+        end else begin
+          hc_d  = hc_q + 8'd1;
+        end
+      end
+      default: qs_d = QIdle;
+    endcase
     // A Q arriving now waits for the next boundary.
     if (cq_valid && cq_type == TypQ) begin
       pend_v_d = 1'b1;
@@ -198,25 +215,29 @@ module de_sdram_frames #(
 
   always_ff @(posedge clk_sdram_i) begin
     if (rst_sd) begin
-      seq_q      <= '0;
-      seq_v_q    <= 1'b0;
-      pend_q     <= '0;
-      pend_v_q   <= 1'b0;
-      idx_q      <= 7'd0;
-      hc_q       <= 8'd0;
-      sel_q      <= 1'b0;
-      use_q      <= 1'b0;
-      slot_sel_q <= 6'd0;
+      qs_q        <= QIdle;
+      seq_q       <= '0;
+      seq_v_q     <= 1'b0;
+      pend_q      <= '0;
+      pend_v_q    <= 1'b0;
+      idx_q       <= 7'd0;
+      hc_q        <= 8'd0;
+      use_q       <= 1'b0;
+      slot_sel_q  <= 6'd0;
+      hold_done_q <= 1'b0;
+      last_q      <= 1'b0;
     end else begin
-      seq_q      <= seq_d;
-      seq_v_q    <= seq_v_d;
-      pend_q     <= pend_d;
-      pend_v_q   <= pend_v_d;
-      idx_q      <= idx_d;
-      hc_q       <= hc_d;
-      sel_q      <= sel_d;
-      use_q      <= use_d;
-      slot_sel_q <= slot_sel_d;
+      qs_q        <= qs_d;
+      seq_q       <= seq_d;
+      seq_v_q     <= seq_v_d;
+      pend_q      <= pend_d;
+      pend_v_q    <= pend_v_d;
+      idx_q       <= idx_d;
+      hc_q        <= hc_d;
+      use_q       <= use_d;
+      slot_sel_q  <= slot_sel_d;
+      hold_done_q <= hold_done_d;
+      last_q      <= last_d;
     end
   end
 
