@@ -7,9 +7,11 @@
 // two flip-flops (ASYNC_REG), so a pointer in flight is either its old or its new value
 // and full / empty are conservative, never wrong.
 //
-// Write side: wready_o = not full; wfree_o = free entries, registered and conservative
-// (it counts every push up to this clock, and pops only once they have crossed), for a
-// writer that reserves room ahead (credit: the SDRAM read bursts of de_frame_fetch).
+// Write side: wready_o = not full; wfree_o = free entries, registered and conservative:
+// it counts every push up to this clock as if one more came in this clock, and pops only
+// once they have crossed (it does not wait for this clock's push, so the push decision
+// and the pointer arithmetic are in different clocks). For a writer that reserves room
+// ahead (credit: the SDRAM read bursts of de_frame_fetch).
 // Read side: show-ahead (rvalid_o / rdata_o / rready_o). The memory is read only when
 // the synchronised write pointer says the entry is written, at least one read clock after
 // the synchroniser saw it, into the output register, so the two ports never touch the
@@ -58,7 +60,7 @@ module de_async_fifo #(
   logic [Width-1:0] mem_q [Depth];
 
   // Write side.
-  ptr_t wbin_d, wbin_q, wgray_q, rbin_w_q, wfree_d, wfree_q;
+  ptr_t wbin_d, wbin_q, wgray_q, rbin_w_q, wfree_d, wfree_q, used;
   (* ASYNC_REG = "TRUE" *) ptr_t rgray_w1_q, rgray_w2_q;
   logic push;
   // Read side.
@@ -71,10 +73,12 @@ module de_async_fifo #(
 
   // The read pointer in binary is registered too (one more clock of conservatism): the
   // Gray decode is off the 125 MHz write side's paths.
-  assign wready_o = (wbin_q - rbin_w_q) != ptr_t'(Depth);
+  assign used     = wbin_q - rbin_w_q;                 // 0 .. Depth
+  assign wready_o = !used[AW];
   assign push     = wvalid_i && wready_o;
   assign wbin_d   = push ? wbin_q + 1'b1 : wbin_q;
-  assign wfree_d  = ptr_t'(Depth) - (wbin_d - rbin_w_q);
+  // Depth - 1 - used (a push this clock counted whether or not it comes), 0 when full.
+  assign wfree_d  = used[AW] ? '0 : {1'b0, ~used[AW-1:0]};
 
   always_ff @(posedge wclk_i) begin
     if (push) mem_q[wbin_q[AW-1:0]] <= wdata_i;
