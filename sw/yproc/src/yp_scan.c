@@ -212,6 +212,11 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         }
         double *f = s->tmp;
         hsr_status st = HSR_OK;
+        /* coherent fitting: the previous frame's line, its terms before Acc_mode (the
+         * colour functions) and after (the specular terms) */
+        const yp_cmdlist *pl = s->o->prev ? &s->o->prev[c * s->H + y] : NULL;
+        int pacc = 0;
+        while (pl && pacc < pl->n && pl->c[pacc].op != YP_ACCMODE) pacc++;
         for (int lev = 1; lev <= e->maxlev && st == HSR_OK; lev++) {
             /* target: cov * colour over the covered pixels (Dis elsewhere) */
             for (int x = a; x <= cl; x++) {
@@ -229,7 +234,8 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             double *tv = s->tolv;
             for (int x = a; x <= cl; x++) tv[x - a] = cov[x - x0] < 1 ? fmin(tol, TOL_PARTIAL) : tol;
             st = push_dis(&s->wl[lev], cv, a, a + n, a);
-            if (st == HSR_OK && yp_fit(f, cv, tv, n, a, lev - 1, tol, 0, &s->wl[lev]) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK && yp_fit_coherent(f, cv, tv, n, a, lev - 1, tol, 0, pl, 0, pacc, &s->wl[lev], NULL) < 0)
+                st = HSR_ELIMIT;
             if (st == HSR_OK) st = arena_list(&s->ar, &s->wl[lev], &e->lv[lev]);
             e->cost[lev] = e->lv[lev].slots;
         }
@@ -239,9 +245,20 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             unsigned char *use = s->use2;
             for (int x = a; x <= cl; x++)
                 if (full[x] && s->fs[3 * nl * x + 3 * l + c] > ltol) { if (sa < 0) sa = x; sb = x; }
+            /* coherent: a specular term of the previous frame that starts at or left of sa
+             * over fully covered pixels keeps its start (its end grows if need be), so its
+             * Sets can stay; not if it is more than twice (and 32 pixels) longer */
+            for (int i = pacc + 1; pl && i < pl->n; i++) {
+                const yp_cmd *e = &pl->c[i];
+                int ea = e->x, eb = e->x + e->dx - 1 > sb ? e->x + e->dx - 1 : sb, okr = 1;
+                if (e->op != YP_EVAL || e->order != 2 || ea > sa || ea < a || eb > cl || eb + 1 - ea > 2 * (sb + 1 - sa) + 32) continue;
+                for (int x = ea; x <= eb && okr; x++) okr = full[x];
+                if (okr) { sa = ea; sb = eb; break; }
+            }
             for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
             st = push_dis(&s->wspec, use, sa, sb + 1, sa);
-            if (st == HSR_OK && yp_fit(f, use, NULL, sb + 1 - sa, sa, 2, ltol, 1, &s->wspec) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK && yp_fit_coherent(f, use, NULL, sb + 1 - sa, sa, 2, ltol, 1, pl, pacc, pl ? pl->n : 0, &s->wspec, NULL) < 0)
+                st = HSR_ELIMIT;
         }
         if (st == HSR_OK) st = arena_list(&s->ar, &s->wspec, &e->spec);
         /* the texture term: cov * texture over the covered pixels, one Eval3 spline whose

@@ -5,7 +5,7 @@
  *  then a full hsr_rebuild of the resulting MLR, for comparison)
  *   yproc scan SCENE -o OUTDIR [--mode M] [--no-aa] [--shading S] [--frames N]
  *                    [--cmd] [--tol T] [--capacity N] [--expect]
- *   yproc anim ANIMSCENE -o OUTDIR [scan options] [--full] [--lod-loop]
+ *   yproc anim ANIMSCENE -o OUTDIR [scan options] [--full] [--lod-loop] [--coherent]
  * (scan / anim: docs/yproc.md)
  * Reads the scene (and its OBJ files), applies viewing and perspective,
  * runs the exact incremental HSR and writes the requested outputs.
@@ -28,7 +28,7 @@ static const char USAGE[] =
     "       yproc scan SCENE -o OUTDIR [--mode 640x480|640x485|1280x1024] [--no-aa]\n"
     "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
     "                  [--capacity SLOTS] [--expect] [--no-degrade] [--lod L]\n"
-    "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full] [--lod-loop]\n"
+    "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full] [--lod-loop] [--coherent]\n"
     "       yproc read SCENE -o FILE.json\n"
     "       yproc serve SCENE --dir DIR\n"
     "\n"
@@ -49,6 +49,8 @@ static const char USAGE[] =
     "      --full          re-render every frame in full (the baseline)\n"
     "      --lod-loop      per-line level of detail from the previous frame's Load Monitor\n"
     "                      counts (model of rtl/ctrl/de_load_monitor.sv; implies --no-degrade)\n"
+    "      --coherent      keep the previous frame's colour functions where they still meet the\n"
+    "                      tolerance, refit only the failing spans (docs/yproc.md 11)\n"
     "read  the scene and its OBJ/MTL files as read, as JSON (schema hsr-scene-1, docs/hsr.md):\n"
     "      what the Python reference renderer draws, so every format has one reader\n"
     "serve the scene held for the viewer (docs/viewer.md): one request a line on stdin (pick,\n"

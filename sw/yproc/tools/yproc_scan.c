@@ -1,6 +1,7 @@
 /* yproc_scan.c - `yproc scan` and `yproc anim` (docs/yproc.md): scene ->
  * HSR -> y-processor -> r/g/b command streams, stats.json, summary line. */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +27,7 @@ typedef struct opts {
     yp_options yo;
     int frames, cmd, expect, full, width, height, mode_given;
     int lod_loop;        /* anim: per-line level of detail from the Load Monitor model */
+    int coherent;        /* anim: temporally coherent fitting (yp_options.prev) */
     int lod_all;         /* scan: every line at this level of detail (-1: the options) */
 } opts;
 
@@ -44,6 +46,7 @@ static int parse(int argc, char **argv, opts *o)
         else if (!strcmp(a, "--full")) o->full = 1;
         else if (!strcmp(a, "--no-degrade")) o->yo.no_degrade = 1;
         else if (!strcmp(a, "--lod-loop")) { o->lod_loop = 1; o->yo.no_degrade = 1; }
+        else if (!strcmp(a, "--coherent")) o->coherent = 1;
         else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
                  && strcmp(a, "--tol") && strcmp(a, "--capacity") && strcmp(a, "--lod"))
             return yproc_usage_error("unknown option", a);
@@ -325,6 +328,24 @@ static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap)
     return 0;
 }
 
+/* the frame's worst pixel: max over colours and pixels of |the array's 12-bit value
+ * (yp_simulate_line) - the exact shading (fr->ideal)|, pixel units */
+static double frame_max_err(const yp_frame *fr)
+{
+    int W = fr->width, H = fr->height;
+    double mx = 0;
+    uint16_t *pix = malloc(sizeof(uint16_t) * (size_t)W);
+    if (!pix) return -1;
+    for (int c = 0; c < 3; c++)
+        for (int y = 0; y < H; y++) {
+            yp_simulate_line(&fr->line[c * H + y], W, pix);
+            const double *id = &fr->ideal[((size_t)c * H + y) * W];
+            for (int x = 0; x < W; x++) if (fabs(pix[x] - id[x]) > mx) mx = fabs(pix[x] - id[x]);
+        }
+    free(pix);
+    return mx;
+}
+
 static int anim_main(opts *o)
 {
     char err[1024] = "", p[4096];
@@ -340,10 +361,11 @@ static int anim_main(opts *o)
     int rc = 0, F = yp_anim_frames(an), W = sc->width, H = sc->height;
     yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
     int *chslots = calloc(3 * (size_t)H, sizeof(int));
+    int *chcmds = calloc(3 * (size_t)H, sizeof(int));
     unsigned char *lod_prev = malloc((size_t)H + 1);
     char *changed[3];
     for (int c = 0; c < 3; c++) changed[c] = calloc((size_t)H, 1);
-    if (!prev || !chslots || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
+    if (!prev || !chslots || !chcmds || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
     memset(lod_prev, YP_LOD_MAX, (size_t)H);
     yp_lod *lod = NULL;
     if ((st = yp_anim_apply(an, 0, NULL, NULL, NULL, NULL)) != HSR_OK
@@ -365,8 +387,9 @@ static int anim_main(opts *o)
     FILE *js = fopen(p, "w");
     if (!js) { rc = 1; goto out; }
     fprintf(js, "{\"format\": \"yproc-anim-1\", \"anim\": \"%s\", \"frames\": %d, \"width\": %d, \"height\": %d, "
-                "\"capacity\": %d, \"lod_loop\": %d, \"no_degrade\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f",
-            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->yo.no_degrade, t1 - t0);
+                "\"capacity\": %d, \"lod_loop\": %d, \"no_degrade\": %d, \"coherent\": %d, \"tol\": %g,\n \"frame\": [\n  "
+                "{\"frame\": 0, \"full_ms\": %.3f, \"max_abs_err\": %.4f",
+            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->yo.no_degrade, o->coherent, o->yo.tol, t1 - t0, frame_max_err(fr));
     if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; fclose(js); goto out; }
     fprintf(js, "}");
     double sum_inc = 0, sum_full = 0, sum_inc_scan = 0, sum_full_scan = 0;
@@ -380,6 +403,7 @@ static int anim_main(opts *o)
         for (int y = 0; lod && y < H; y++)
             if (lod_prev[y] != yp_lod_levels(lod)[y]) { if (y0 == y1) { y0 = y; y1 = y + 1; } if (y < y0) y0 = y; if (y + 1 > y1) y1 = y + 1; }
         if (lod) memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
+        if (o->coherent) o->yo.prev = prev;          /* the frame before this one */
         double am = now_ms();
         if (st == HSR_OK) st = yp_scan(sh, h, &o->yo, y0, y1, fr);
         double a1 = now_ms();
@@ -390,10 +414,11 @@ static int anim_main(opts *o)
                 changed[c][y] = y >= y0 && y < y1 && !yp_cmdlist_equal(&fr->line[c * H + y], &prev[c * H + y]);
                 nch[c] += changed[c][y];
                 /* instructions of the line that the delta really changes (LCS of the commands) */
-                chslots[c * H + y] = changed[c][y] ? yp_cmdlist_changed_slots(&prev[c * H + y], &fr->line[c * H + y]) : 0;
+                chcmds[c * H + y] = 0;
+                chslots[c * H + y] = changed[c][y] ? yp_cmdlist_changed(&prev[c * H + y], &fr->line[c * H + y], &chcmds[c * H + y]) : 0;
             }
         snprintf(p, sizeof p, "%s/frame%03d.delta", o->out, f);
-        if (write_delta(p, f, fr, changed) || copy_lines(prev, fr)) { rc = 1; break; }
+        if (write_delta(p, f, fr, changed)) { rc = 1; break; }
         double a2 = now_ms();
         /* the same frame from scratch: HSR rebuild + every line */
         double b0 = now_ms();
@@ -414,17 +439,22 @@ static int anim_main(opts *o)
             if (mkdir_p(p) || write_streams(ff, p, o->cmd)) rc = 1;
         }
         yp_frame_free(ff); hsr_destroy(hf);
-        if (st != HSR_OK) { rc = 1; break; }
+        if (st != HSR_OK || copy_lines(prev, fr)) { rc = 1; break; }
         sum_inc += a1 - a0; sum_full += b1 - b0; sum_changed += nch[0] + nch[1] + nch[2];
         sum_inc_scan += a1 - am; sum_full_scan += b1 - bm;
         fprintf(js, ",\n  {\"frame\": %d, \"rescanned_lines\": [%d, %d], \"changed_lines\": [%d, %d, %d], "
                     "\"incremental_ms\": %.3f, \"incremental_hsr_ms\": %.3f, \"incremental_scan_ms\": %.3f, "
                     "\"delta_write_ms\": %.3f, \"full_ms\": %.3f, \"full_hsr_ms\": %.3f, \"full_scan_ms\": %.3f, "
-                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d",
-                f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am, a2 - a1, b1 - b0, bm - b0, b1 - bm, diff, deg);
+                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d, \"max_abs_err\": %.4f",
+                f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am, a2 - a1, b1 - b0, bm - b0, b1 - bm, diff, deg,
+                frame_max_err(fr));
         fprintf(js, ", \"changed_slots\": [");
         for (int c = 0; c < 3; c++)
             for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chslots[c * H + y], y == H - 1 ? "]" : "");
+        fprintf(js, "]");
+        fprintf(js, ", \"changed_cmds\": [");
+        for (int c = 0; c < 3; c++)
+            for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chcmds[c * H + y], y == H - 1 ? "]" : "");
         fprintf(js, "]");
         if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; break; }
         fprintf(js, "}");
@@ -446,7 +476,7 @@ static int anim_main(opts *o)
     }
 out:
     if (prev) for (int i = 0; i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
-    free(prev); free(chslots); free(lod_prev); yp_lod_free(lod);
+    free(prev); free(chslots); free(chcmds); free(lod_prev); yp_lod_free(lod);
     for (int c = 0; c < 3; c++) free(changed[c]);
     yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); yp_anim_free(an);
     return rc;
