@@ -38,6 +38,9 @@ typedef struct yp_options {
      * frame then depends on the one before it (the error bound, not the instruction,
      * is the contract) */
     const yp_cmdlist *prev;
+    int coherent;        /* 1: the line structure of coherent fitting, from the first frame
+                          * on (a partly covered pixel at either end of a pattern's span gets
+                          * its own Eval1, so the spline between them can stay) */
 } yp_options;
 void yp_options_default(yp_options *o);            /* 640x480 capacity, aa, phong, tol 1 */
 /* slots per line of a video mode "640x480" | "640x485" | "1280x1024"

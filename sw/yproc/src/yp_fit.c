@@ -288,12 +288,22 @@ static hsr_status push_fset(fset **s, int *ns, int *cap, fset v)
 #define YP_COH_LMIN 24    /* pixels the old spline must hold after a resync [choice] */
 
 int yp_fit_coherent(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order,
-                    double tol, int clamp, const yp_cmdlist *prev, int i0, int i1, yp_cmdlist *out, int *kept)
+                    double tol, int clamp, double hyst, const yp_cmdlist *prev, int i0, int i1, yp_cmdlist *out,
+                    int *kept)
 {
     if (kept) *kept = 0;
-    if (!prev || order < 1 || order > 2 || n <= 0 || i0 < 0 || i1 > prev->n)
-        return yp_fit(f, use, tolv, n, x0, order, tol, clamp, out);
-    const double S = YP_ONE, T = tol * S * (1 - 1e-9);
+    if (n <= 0) return -1;
+    /* what is (re)fitted is fitted at hyst * tol; an old spline is kept while within tol */
+    double *th = malloc(sizeof(double) * (size_t)n);
+    if (!th) return yp_fit(f, use, tolv, n, x0, order, tol, clamp, out);
+    for (int x = 0; x < n; x++) th[x] = (tolv ? tolv[x] : tol) * hyst;
+    const double tf = tol * hyst;
+    if (!prev || order < 1 || order > 2 || i0 < 0 || i1 > prev->n) {
+        int r = yp_fit(f, use, th, n, x0, order, tf, clamp, out);
+        free(th);
+        return r;
+    }
+    const double S = YP_ONE, T = tf * S * (1 - 1e-9);
     int oldcap = 0;
     for (int i = i0; i < i1; i++) oldcap += prev->c[i].op >= YP_SETI && prev->c[i].op <= YP_SETDDI;
     fset *os = malloc(sizeof(fset) * (size_t)(oldcap + 1)), *ns_ = NULL;
@@ -323,6 +333,7 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
     int64_t hv[3] = {oe->v[0], oe->v[1], oe->v[2]};
     segtab tb = {tab, tab + n + 1, tab + 2 * (n + 1), 0};
     int sync = 0, xf = nextfail[0], io = 0;   /* on the old spline from column sync; io: next old Set */
+    int fresh = 0, nold = 0;                  /* a new Eval; old Sets kept */
     while (xf < n && st == HSR_OK) {
         /* refit from the last old knot that still lets the refit reach xf */
         int k = sync;
@@ -332,7 +343,7 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
             if (os[io].pos >= sync) {
                 int dup = 0;   /* a resync at sync already holds the old Set */
                 for (int j = 0; j < nns; j++) dup |= ns_[j].pos == os[io].pos && ns_[j].reg == os[io].reg;
-                if (!dup) st = push_fset(&ns_, &nns, &nscap, os[io]);
+                if (!dup) { st = push_fset(&ns_, &nns, &nscap, os[io]); nold++; }
             }
         for (int j = 0; j < nns; j++) if (ns_[j].pos == k && ns_[j].reg == order) ns_[j] = ns_[--nns];
         int64_t v[3];
@@ -341,7 +352,7 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
             int j = 1;
             while (j < n && !use[j]) j++;
             hv[0] = llround(f[0] * S); hv[1] = order == 2 && j < n ? llround((f[j] - f[0]) / j * S) : 0; hv[2] = 0;
-            nns = 0;
+            nns = 0; nold = 0; fresh = 1;
         }
         for (int r = 0; r < 3; r++) v[r] = k == 0 ? hv[r] : ost[3 * k + r];
         /* refit segments until the old spline can be taken up again */
@@ -349,17 +360,18 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
         for (;;) {
             double c = 0;
             cohstop cs = {nextfail, n, from, YP_COH_LMIN};
-            int bestp = greedy(f, use, tolv, n, order, T, tol, clamp, k, v, &tb, coh_stop, &cs, &c);
+            int bestp = greedy(f, use, th, n, order, T, tf, clamp, k, v, &tb, coh_stop, &cs, &c);
             if (bestp < 0) goto fallback;
             if (k == 0) hv[order] = (int64_t)c;
             else if ((st = push_fset(&ns_, &nns, &nscap, (fset){k, order, (int64_t)c})) != HSR_OK) break;
             v[order] = (int64_t)c;
             int last = n - 1;
             while (last > bestp && !use[last]) last--;
-            if (last == bestp) { xf = n; break; }             /* reaches the end of the span */
+            if (last == bestp) { xf = n; io = nos; break; }   /* reaches the end: no old Set after it */
             if (coh_stop(&cs, bestp)) {                          /* back onto the old spline */
                 int r = bestp + 1;
                 for (int g = 0; g <= order && st == HSR_OK; g++) st = push_fset(&ns_, &nns, &nscap, (fset){r, g, ost[3 * r + g]});
+                nold++;                                          /* the old spline from r on */
                 sync = r; xf = nextfail[r];
                 while (io < nos && os[io].pos <= r) io++;      /* those at r are the resync's values */
                 break;
@@ -373,14 +385,14 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
     }
     /* the old Sets after the last resync */
     for (; st == HSR_OK && xf >= n && io < nos; io++)
-        if (os[io].pos >= sync) st = push_fset(&ns_, &nns, &nscap, os[io]);
+        if (os[io].pos >= sync) { st = push_fset(&ns_, &nns, &nscap, os[io]); nold++; }
     if (st != HSR_OK) goto fallback;
     qsort(ns_, (size_t)nns, sizeof *ns_, fset_cmp);
     /* the re-check, and the cost against a plain refit: more than a quarter (and 8
      * slots) above it and the line starts afresh, so resyncs do not pile up */
     eval_sets(order, hv, n, ns_, nns, val, NULL);
     for (int x = 0; x < n; x++) if (use[x] && !ok_at((double)val[x] / S, f[x], tolv ? tolv[x] : tol, clamp)) goto fallback;
-    if (yp_fit(f, use, tolv, n, x0, order, tol, clamp, &plain) < 0) goto fallback;
+    if (yp_fit(f, use, th, n, x0, order, tf, clamp, &plain) < 0) goto fallback;
     int slots = order + 3 + 2 * nns;
     if (slots > plain.slots + (plain.slots / 4 > 8 ? plain.slots / 4 : 8)) goto fallback;
     for (int j = 0; j < nns && st == HSR_OK; j++) {
@@ -391,11 +403,11 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
     yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {hv[0], hv[1], hv[2]}};
     if (st == HSR_OK) st = yp_cmdlist_push(out, ev);
     rc = st == HSR_OK ? nns : -1;
-    if (kept) *kept = 1;
+    if (kept) *kept = !fresh || nold > 0;
     goto done;
 fallback:
-    rc = yp_fit(f, use, tolv, n, x0, order, tol, clamp, out);
+    rc = yp_fit(f, use, th, n, x0, order, tf, clamp, out);
 done:
-    free(os); free(ns_); free(val); free(ost); free(nextfail); free(tab); yp_cmdlist_free(&plain);
+    free(th); free(os); free(ns_); free(val); free(ost); free(nextfail); free(tab); yp_cmdlist_free(&plain);
     return rc;
 }

@@ -49,12 +49,12 @@ static void test_coherent_fit_refits_only_a_local_change(void)
     CHECK(worst(&old, f) <= tol + 0.5);
     /* unchanged target: the old commands, all of them */
     int kept = 0;
-    CHECK(yp_fit_coherent(f, use, NULL, N, 0, 2, tol, 0, &old, 0, old.n, &same, &kept) >= 0);
+    CHECK(yp_fit_coherent(f, use, NULL, N, 0, 2, tol, 0, 1, &old, 0, old.n, &same, &kept) >= 0);
     CHECK(kept == 1 && yp_cmdlist_equal(&same, &old));
     CHECK(yp_cmdlist_changed_slots(&old, &same) == 0);
     /* a bump of 40 units around x = 240: only its neighbourhood is refitted */
     target(g, 40, 240, 1);
-    CHECK(yp_fit_coherent(g, use, NULL, N, 0, 2, tol, 0, &old, 0, old.n, &coh, &kept) >= 0);
+    CHECK(yp_fit_coherent(g, use, NULL, N, 0, 2, tol, 0, 1, &old, 0, old.n, &coh, &kept) >= 0);
     CHECK(yp_fit(g, use, NULL, N, 0, 2, tol, 0, &plain) >= 0);
     CHECK(kept == 1);
     CHECK(worst(&coh, g) <= tol + 0.5);
@@ -73,24 +73,46 @@ static void test_coherent_fit_refits_only_a_local_change(void)
         }
     }
     CHECK(outside > 4 && found == outside);
+    /* a bump at the end of the span: the refit runs to the end, the Sets before it stay */
+    yp_cmdlist end = {0};
+    target(g, 40, N - 8, 1);
+    CHECK(yp_fit_coherent(g, use, NULL, N, 0, 2, tol, 0, 1, &old, 0, old.n, &end, &kept) >= 0);
+    CHECK(kept == 1 && worst(&end, g) <= tol + 0.5);
+    CHECK(yp_cmdlist_changed_slots(&old, &end) < 16);
+    yp_cmdlist_free(&end);
     /* a target changed everywhere (10 % brighter): the plain fit */
     yp_cmdlist all = {0}, allp = {0};
     target(g, 0, 0, 1.1);
-    CHECK(yp_fit_coherent(g, use, NULL, N, 0, 2, tol, 0, &old, 0, old.n, &all, &kept) >= 0);
+    CHECK(yp_fit_coherent(g, use, NULL, N, 0, 2, tol, 0, 1, &old, 0, old.n, &all, &kept) >= 0);
     CHECK(yp_fit(g, use, NULL, N, 0, 2, tol, 0, &allp) >= 0);
     CHECK(kept == 0 && yp_cmdlist_equal(&all, &allp));
     /* no candidate (another start column) and no previous line: the plain fit too */
     yp_cmdlist nc = {0}, np = {0}, fp = {0};
-    CHECK(yp_fit_coherent(f, use, NULL, N - 1, 1, 2, tol, 0, &old, 0, old.n, &nc, &kept) >= 0 && kept == 0);
+    CHECK(yp_fit_coherent(f, use, NULL, N - 1, 1, 2, tol, 0, 1, &old, 0, old.n, &nc, &kept) >= 0 && kept == 0);
     CHECK(yp_fit(f, use, NULL, N - 1, 1, 2, tol, 0, &fp) >= 0 && yp_cmdlist_equal(&nc, &fp));
-    CHECK(yp_fit_coherent(f, use, NULL, N, 0, 2, tol, 0, NULL, 0, 0, &np, &kept) >= 0 && kept == 0);
+    CHECK(yp_fit_coherent(f, use, NULL, N, 0, 2, tol, 0, 1, NULL, 0, 0, &np, &kept) >= 0 && kept == 0);
     yp_cmdlist_free(&old); yp_cmdlist_free(&same); yp_cmdlist_free(&coh); yp_cmdlist_free(&plain);
     yp_cmdlist_free(&all); yp_cmdlist_free(&allp); yp_cmdlist_free(&nc); yp_cmdlist_free(&np); yp_cmdlist_free(&fp);
 }
 
 /* a drifting target, frame after frame (a slowly moving light): every frame within the
  * tolerance, fewer changed slots than plain refits, and the line does not grow */
+static long drift(double hyst, double bright, int *maxslots, int *plainslots);
+
 static void test_coherent_fit_follows_a_slow_drift(void)
+{
+    int mx1, pl1, mx5, pl5;
+    /* a bump moving 2 pixels a frame */
+    long b1 = drift(1, 0, &mx1, &pl1), b5 = drift(0.5, 0, &mx5, &pl5);
+    fprintf(stderr, "  moving bump: hysteresis 1: %ld changed slots (line at most %d of a plain %d), 0.5: %ld\n", b1, mx1, pl1, b5);
+    /* and the whole target brightening by 0.04 % a frame (about 1 unit): hysteresis pays */
+    long g1 = drift(1, 4e-4, &mx1, &pl1), g5 = drift(0.5, 4e-4, &mx5, &pl5);
+    fprintf(stderr, "  + brightening: hysteresis 1: %ld changed slots, 0.5: %ld (line at most %d of a plain %d)\n", g1, g5, mx5, pl5);
+    CHECK(g5 < g1);
+}
+
+/* changed slots of the drifting target over 40 frames with coherent fitting at hyst */
+static long drift(double hyst, double bright, int *maxslots, int *plainslots)
 {
     double f[N];
     unsigned char use[N];
@@ -98,29 +120,28 @@ static void test_coherent_fit_follows_a_slow_drift(void)
     const double tol = 4;
     yp_cmdlist cur = {0}, pcur = {0};
     target(f, 200, 100, 1);
-    CHECK(yp_fit(f, use, NULL, N, 0, 2, tol, 0, &cur) >= 0);
-    CHECK(yp_fit(f, use, NULL, N, 0, 2, tol, 0, &pcur) >= 0);
+    CHECK(yp_fit(f, use, NULL, N, 0, 2, tol * hyst, 0, &cur) >= 0);
+    CHECK(yp_fit(f, use, NULL, N, 0, 2, tol * hyst, 0, &pcur) >= 0);
     long ch_coh = 0, ch_plain = 0;
-    int maxslots = 0, plainslots = 0;
+    *maxslots = *plainslots = 0;
     for (int fr = 1; fr <= 40; fr++) {
-        target(f, 200, 100 + 2.0 * fr, 1);     /* the bump moves 2 pixels a frame */
+        target(f, 200, 100 + 2.0 * fr, 1 + bright * fr);     /* the bump moves 2 pixels a frame */
         yp_cmdlist nxt = {0}, pn = {0};
         int kept;
-        CHECK(yp_fit_coherent(f, use, NULL, N, 0, 2, tol, 0, &cur, 0, cur.n, &nxt, &kept) >= 0);
-        CHECK(yp_fit(f, use, NULL, N, 0, 2, tol, 0, &pn) >= 0);
+        CHECK(yp_fit_coherent(f, use, NULL, N, 0, 2, tol, 0, hyst, &cur, 0, cur.n, &nxt, &kept) >= 0);
+        CHECK(yp_fit(f, use, NULL, N, 0, 2, tol * hyst, 0, &pn) >= 0);   /* refit every frame, as tight */
         CHECK(worst(&nxt, f) <= tol + 0.5);
         ch_coh += yp_cmdlist_changed_slots(&cur, &nxt);
         ch_plain += yp_cmdlist_changed_slots(&pcur, &pn);
-        if (nxt.slots > maxslots) maxslots = nxt.slots;
-        if (pn.slots > plainslots) plainslots = pn.slots;
+        if (nxt.slots > *maxslots) *maxslots = nxt.slots;
+        if (pn.slots > *plainslots) *plainslots = pn.slots;
         yp_cmdlist_free(&cur); yp_cmdlist_free(&pcur);
         cur = nxt; pcur = pn;
     }
-    fprintf(stderr, "  drift: changed slots %ld coherent, %ld plain; line at most %d / %d slots\n", ch_coh, ch_plain, maxslots,
-            plainslots);
-    CHECK(2 * ch_coh < ch_plain);
-    CHECK(4 * maxslots <= 5 * plainslots + 4 * 8);   /* the quarter (and 8 slots) above a plain fit */
+    CHECK(2 * ch_coh < ch_plain || hyst < 1 || bright > 0);
+    CHECK(4 * *maxslots <= 5 * *plainslots + 4 * 8);   /* the quarter (and 8 slots) above a plain fit */
     yp_cmdlist_free(&cur); yp_cmdlist_free(&pcur);
+    return ch_coh;
 }
 
 void suite_yp_coh(void);

@@ -46,7 +46,7 @@ static int parse(int argc, char **argv, opts *o)
         else if (!strcmp(a, "--full")) o->full = 1;
         else if (!strcmp(a, "--no-degrade")) o->yo.no_degrade = 1;
         else if (!strcmp(a, "--lod-loop")) { o->lod_loop = 1; o->yo.no_degrade = 1; }
-        else if (!strcmp(a, "--coherent")) o->coherent = 1;
+        else if (!strcmp(a, "--coherent")) o->coherent = o->yo.coherent = 1;
         else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
                  && strcmp(a, "--tol") && strcmp(a, "--capacity") && strcmp(a, "--lod"))
             return yproc_usage_error("unknown option", a);
@@ -382,7 +382,7 @@ static int anim_main(opts *o)
     double t1 = now_ms();
     if (mkdir_p(o->out)) { rc = 1; goto out; }
     snprintf(p, sizeof p, "%s/frame000", o->out);
-    if (mkdir_p(p) || write_streams(fr, p, o->cmd) || copy_lines(prev, fr)) { rc = 1; goto out; }
+    if (mkdir_p(p) || write_streams(fr, p, o->cmd) || (o->expect && write_expect(fr, p)) || copy_lines(prev, fr)) { rc = 1; goto out; }
     snprintf(p, sizeof p, "%s/anim_stats.json", o->out);
     FILE *js = fopen(p, "w");
     if (!js) { rc = 1; goto out; }
@@ -436,7 +436,7 @@ static int anim_main(opts *o)
         degraded_lines += deg;
         if (st == HSR_OK && o->full) {
             snprintf(p, sizeof p, "%s/frame%03d", o->out, f);
-            if (mkdir_p(p) || write_streams(ff, p, o->cmd)) rc = 1;
+            if (mkdir_p(p) || write_streams(ff, p, o->cmd) || (o->expect && write_expect(ff, p))) rc = 1;
         }
         yp_frame_free(ff); hsr_destroy(hf);
         if (st != HSR_OK || copy_lines(prev, fr)) { rc = 1; break; }
