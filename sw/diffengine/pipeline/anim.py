@@ -107,6 +107,13 @@ frame (the slots of each new line not on the longest common subsequence of its c
 with the previous frame's line, counted by yproc), as a histogram and per frame.
 
     diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim] [--model fast|numpy]
+                    [--coherent] [--tol T]
+    diffengine anim --anim A --out D --coh-sweep [--frames N] [--legs 8,32,..] [--runs 4:coh:aa,..]
+
+--coherent keeps the previous frame's colour functions where they still meet the tolerance
+(yproc anim --coherent, docs/yproc.md section 11). --coh-sweep runs the animation at
+several light speeds (frames per `wander` leg) and tolerances, with and without it, and
+plots the median changed instructions per pattern line (sweep.png, sweep.json).
 
 Exit status 0 only if no frame differs from its full re-render.
 """
@@ -228,7 +235,9 @@ def changed_summary(d: Path) -> dict:
     """Changed instructions of one `yproc anim` run over the lines the pattern covers (more
     than the background term in frame 0): medians of changed slots and commands per line
     and colour over every later frame, lines with no change counted as 0; the worst
-    pixel against the exact shading (max_abs_err) over every frame."""
+    pixel against the exact shading (max_abs_err) over every frame; how far the exact
+    shading moves a frame (the per-frame median and 90th percentile over the pixels that
+    moved, their median over the frames)."""
     st = json.loads((Path(d) / "anim_stats.json").read_text())
     f0 = [lines_of_de48(Path(d) / "frame000" / f"{c}.de48") for c in "rgb"]
     cover = np.array([[len(ln) // 6 - 1 > 3 for ln in ch] for ch in f0])          # (3, H)
@@ -240,6 +249,10 @@ def changed_summary(d: Path) -> dict:
             "mean_slots": float(cs.mean()), "median_cmds": float(np.median(cc)),
             "unchanged_share": float((cs == 0).mean()), "slots_per_line": float(slots.mean()),
             "max_abs_err": max(f["max_abs_err"] for f in st["frame"]), "tol": st["tol"],
+            "exact_change_median": float(np.median([f["exact_change"]["median"] for f in per]))
+            if all("exact_change" in f for f in per) else None,
+            "exact_change_p90": float(np.median([f["exact_change"]["p90"] for f in per]))
+            if all("exact_change" in f for f in per) else None,
             "frames_differing_from_full": st["frames_differing_from_full"],
             "mean_incremental_ms": st["mean_incremental_ms"]}
 
@@ -252,8 +265,8 @@ SWEEP_RUNS = ((1, True, True), (4, True, True), (32, True, True), (4, True, Fals
 def coherence_sweep(anim_path, out: Path, frames: int = 10, legs=SWEEP_LEGS, runs=SWEEP_RUNS) -> list[dict]:
     """`yproc anim` of `anim_path` for every light speed (frames per `wander` leg) and run
     (tolerance, --coherent, anti-aliasing; the plain runs at the slowest and fastest leg
-    only): changed instructions per pattern line (changed_summary). Writes sweep.json and
-    sweep.png."""
+    only): changed instructions per pattern line (changed_summary). Writes sweep.json (with
+    the runs of an earlier sweep into `out` that were not repeated) and sweep.png."""
     yproc = build_yproc()
     res = []
     for tol, coh, aa in runs:
@@ -272,6 +285,11 @@ def coherence_sweep(anim_path, out: Path, frames: int = 10, legs=SWEEP_LEGS, run
                   f"median {row['median_slots']:.0f} slots / {row['median_cmds']:.0f} commands changed per "
                   f"line, {100 * row['unchanged_share']:.0f} % of lines unchanged, worst pixel "
                   f"{row['max_abs_err']:.2f} ({time.time() - t0:.0f} s)", flush=True)
+    # runs of an earlier sweep into the same folder stay unless re-run here
+    key = lambda r: (r["tol"], r["coherent"], r["aa"], r["leg"])
+    old = json.loads((out / "sweep.json").read_text()) if (out / "sweep.json").exists() else []
+    new = {key(r) for r in res}
+    res = sorted([r for r in old if key(r) not in new] + res, key=key)
     (out / "sweep.json").write_text(json.dumps(res, indent=1) + "\n")
     plot_sweep(res, out / "sweep.png", Path(anim_path).name, frames)
     return res
@@ -396,6 +414,10 @@ def configure(ap) -> None:
                     help="instead: the animation at several light speeds and tolerances, with and "
                          "without --coherent: changed instructions per line -> OUT/sweep.png, sweep.json")
     ap.add_argument("--frames", type=int, default=10, help="with --coh-sweep: frames per run (default 10)")
+    ap.add_argument("--legs", help="with --coh-sweep: frames per leg of the light, comma-separated "
+                                   f"(default {','.join(map(str, SWEEP_LEGS))})")
+    ap.add_argument("--runs", help="with --coh-sweep: the runs as TOL:coh|plain:aa|noaa, comma-separated "
+                                   "(default: every one of SWEEP_RUNS)")
     ap.set_defaults(func=command)
 
 
@@ -412,9 +434,20 @@ def command(a) -> int:
         print(f"wrote {out / 'lod.png'}, {out / 'lod.json'}")
         return 0
     if a.coh_sweep:
-        print(f"anim: {a.anim} at light speeds {SWEEP_LEGS} frames per leg, {a.frames} frames a run", flush=True)
+        print(f"anim: {a.anim} at light speeds {a.legs or SWEEP_LEGS} frames per leg, {a.frames} frames a run",
+              flush=True)
         try:
-            coherence_sweep(a.anim, out, a.frames)
+            legs = tuple(int(v) for v in a.legs.split(",")) if a.legs else SWEEP_LEGS
+            runs = SWEEP_RUNS
+            if a.runs:
+                runs = []
+                for r in a.runs.split(","):
+                    t, c, aa = r.split(":")
+                    if c not in ("coh", "plain") or aa not in ("aa", "noaa"):
+                        print(f"anim: --runs: '{r}' is not TOL:coh|plain:aa|noaa", file=sys.stderr)
+                        return 2
+                    runs.append((float(t) if "." in t else int(t), c == "coh", aa == "aa"))
+            coherence_sweep(a.anim, out, a.frames, legs, runs)
         except RuntimeError as e:
             print(f"anim: error: {e}", file=sys.stderr)
             return 1

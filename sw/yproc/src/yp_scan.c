@@ -252,6 +252,14 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
                 if (!(k ? eb : ea)) continue;
                 int x = k ? cl : a;
                 yp_cmd e1 = {YP_EVAL, 0, (uint16_t)x, 1, {q24(f[x - a]), 0, 0}};
+                /* the previous frame's Eval1 of this pixel stays while within cov * tol of
+                 * the target: the pixel's error, summed over the patterns sharing it, stays
+                 * within tol, as on a fully covered pixel */
+                for (int i = 0; pl && i < pacc; i++) {
+                    const yp_cmd *q = &pl->c[i];
+                    if (q->op == YP_EVAL && q->order == 0 && q->x == x && q->dx == 1
+                        && fabs((double)q->v[0] / YP_ONE - f[x - a]) <= cov[x - x0] * tol) { e1 = *q; break; }
+                }
                 st = yp_cmdlist_push(&s->wl[lev], e1);
             }
             if (st == HSR_OK) st = arena_list(&s->ar, &s->wl[lev], &e->lv[lev]);

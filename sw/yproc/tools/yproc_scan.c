@@ -346,6 +346,28 @@ static double frame_max_err(const yp_frame *fr)
     return mx;
 }
 
+static int dcmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* how far the exact shading moved since the previous frame: median, 90th percentile and
+ * max of |ideal - prev| over the pixels (and colours) whose exact value changed; prev then
+ * takes the frame's values.  tmp: room for 3 W H doubles */
+static void exact_change(const yp_frame *fr, double *prev, double *tmp, FILE *js)
+{
+    size_t n = 3 * (size_t)fr->width * (size_t)fr->height, k = 0;
+    for (size_t i = 0; i < n; i++) {
+        double d = fabs(fr->ideal[i] - prev[i]);
+        if (d > 0) tmp[k++] = d;
+        prev[i] = fr->ideal[i];
+    }
+    qsort(tmp, k, sizeof *tmp, dcmp);
+    fprintf(js, ", \"exact_change\": {\"pixels\": %zu, \"median\": %.4f, \"p90\": %.4f, \"max\": %.4f}", k,
+            k ? tmp[k / 2] : 0.0, k ? tmp[(size_t)(0.9 * (double)(k - 1))] : 0.0, k ? tmp[k - 1] : 0.0);
+}
+
 static int anim_main(opts *o)
 {
     char err[1024] = "", p[4096];
@@ -362,10 +384,11 @@ static int anim_main(opts *o)
     yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
     int *chslots = calloc(3 * (size_t)H, sizeof(int));
     int *chcmds = calloc(3 * (size_t)H, sizeof(int));
+    double *ideal_prev = malloc(sizeof(double) * 3 * (size_t)W * (size_t)H), *ideal_tmp = malloc(sizeof(double) * 3 * (size_t)W * (size_t)H);
     unsigned char *lod_prev = malloc((size_t)H + 1);
     char *changed[3];
     for (int c = 0; c < 3; c++) changed[c] = calloc((size_t)H, 1);
-    if (!prev || !chslots || !chcmds || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
+    if (!prev || !chslots || !chcmds || !ideal_prev || !ideal_tmp || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
     memset(lod_prev, YP_LOD_MAX, (size_t)H);
     yp_lod *lod = NULL;
     if ((st = yp_anim_apply(an, 0, NULL, NULL, NULL, NULL)) != HSR_OK
@@ -383,6 +406,7 @@ static int anim_main(opts *o)
     if (mkdir_p(o->out)) { rc = 1; goto out; }
     snprintf(p, sizeof p, "%s/frame000", o->out);
     if (mkdir_p(p) || write_streams(fr, p, o->cmd) || (o->expect && write_expect(fr, p)) || copy_lines(prev, fr)) { rc = 1; goto out; }
+    memcpy(ideal_prev, fr->ideal, sizeof(double) * 3 * (size_t)W * (size_t)H);
     snprintf(p, sizeof p, "%s/anim_stats.json", o->out);
     FILE *js = fopen(p, "w");
     if (!js) { rc = 1; goto out; }
@@ -452,6 +476,7 @@ static int anim_main(opts *o)
         for (int c = 0; c < 3; c++)
             for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chslots[c * H + y], y == H - 1 ? "]" : "");
         fprintf(js, "]");
+        exact_change(fr, ideal_prev, ideal_tmp, js);
         fprintf(js, ", \"changed_cmds\": [");
         for (int c = 0; c < 3; c++)
             for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chcmds[c * H + y], y == H - 1 ? "]" : "");
@@ -476,7 +501,7 @@ static int anim_main(opts *o)
     }
 out:
     if (prev) for (int i = 0; i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
-    free(prev); free(chslots); free(chcmds); free(lod_prev); yp_lod_free(lod);
+    free(prev); free(chslots); free(chcmds); free(ideal_prev); free(ideal_tmp); free(lod_prev); yp_lod_free(lod);
     for (int c = 0; c < 3; c++) free(changed[c]);
     yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); yp_anim_free(an);
     return rc;
