@@ -254,7 +254,11 @@ def changed_summary(d: Path) -> dict:
             "exact_change_p90": float(np.median([f["exact_change"]["p90"] for f in per]))
             if all("exact_change" in f for f in per) else None,
             "frames_differing_from_full": st["frames_differing_from_full"],
-            "mean_incremental_ms": st["mean_incremental_ms"]}
+            "mean_incremental_ms": st["mean_incremental_ms"], "mean_full_ms": st["mean_full_ms"],
+            # YPD1 sends every changed line whole: its bytes against the changed slots' words
+            "delta_bytes_per_frame": float(np.mean([(Path(d) / f"frame{f['frame']:03d}.delta").stat().st_size
+                                                    for f in per])),
+            "changed_words_per_frame": float(np.mean([np.sum(f["changed_slots"]) for f in per]))}
 
 
 SWEEP_LEGS = (8, 32, 128, 512)
