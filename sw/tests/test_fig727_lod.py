@@ -95,6 +95,7 @@ COH_TOL = 4
 def coherent(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("fig727coh")
     slow = anim.anim_variant(_anim(tmp), tmp / "fig7_27_slow.anim", FRAMES, leg=512)
+    assert "wander 0 2718 512 " in slow.read_text() and f"frames {FRAMES}" in slow.read_text()
     st = {}
     for name, flags in (("coh", ("--coherent",)), ("plain", ())):
         st[name] = _yproc(slow, tmp / name, "--full", "--expect", "--cmd", "--tol", COH_TOL, *flags)
