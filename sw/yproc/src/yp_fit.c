@@ -387,7 +387,7 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
     for (; st == HSR_OK && xf >= n && io < nos; io++)
         if (os[io].pos >= sync) { st = push_fset(&ns_, &nns, &nscap, os[io]); nold++; }
     if (st != HSR_OK) goto fallback;
-    qsort(ns_, (size_t)nns, sizeof *ns_, fset_cmp);
+    if (nns) qsort(ns_, (size_t)nns, sizeof *ns_, fset_cmp);
     /* the re-check, and the cost against a plain refit: more than a quarter (and 8
      * slots) above it and the line starts afresh, so resyncs do not pile up */
     eval_sets(order, hv, n, ns_, nns, val, NULL);
