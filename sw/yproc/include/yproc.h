@@ -148,5 +148,15 @@ const unsigned char *yp_lod_levels(const yp_lod *l);     /* [height], for yp_opt
  * all lines, and the same for its two neighbours.  Returns the lines whose level
  * changed. */
 int yp_lod_update(yp_lod *l, const int *issued, const int *late);
+/* The y-processor's own check before a frame is emitted (docs/yproc.md section 10): it
+ * knows every line's instruction count when it has built it, so a line of fr (scanned
+ * with o->line_lod == yp_lod_levels(l)) whose count in some colour exceeds the capacity
+ * (a line the Load Monitor would record late) is lowered one level and re-scanned, until
+ * it fits or is at level 0.  The exact counts at both levels set the line's cost ratio, and
+ * the level above is barred as after a failed raise.  *lowered: lines lowered; [*y0, *y1)
+ * (may be NULL) widened by the re-scanned lines.  The frame then equals a full scan at the
+ * new levels. */
+hsr_status yp_lod_fit(yp_lod *l, const yp_shader *sh, const hsr_ctx *h, const yp_options *o,
+                      yp_frame *fr, int *lowered, int *y0, int *y1);
 
 #endif
