@@ -368,6 +368,15 @@ static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap, int fra
     return 0;
 }
 
+static void tess_json(FILE *js, yp_anim *an, int coarsened)
+{
+    yp_tess *t = yp_anim_tess(an);
+    if (!t) return;
+    fprintf(js, ", \"tess_coarsened\": %d, \"tess\": [", coarsened);
+    for (int k = 0; k < yp_tess_count(t); k++) fprintf(js, "%s%d", k ? ", " : "", yp_tess_get(t, k));
+    fprintf(js, "]");
+}
+
 static int anim_main(opts *o)
 {
     char err[1024] = "", p[4096];
@@ -399,9 +408,9 @@ static int anim_main(opts *o)
     double t0 = now_ms();
     if ((st = hsr_scene_build(sc, &h, &shade)) != HSR_OK) { fprintf(stderr, "%s: %s\n", o->in, hsr_status_str(st)); rc = 1; goto out; }
     free(shade);
-    int lowered = 0;
+    int lowered = 0, coarsened = 0, fy0 = 0, fy1 = H;
     if (yp_frame_new(W, H, &fr) != HSR_OK || yp_scan(sh, h, &o->yo, 0, H, fr) != HSR_OK
-        || (o->lod_predict && yp_lod_fit(lod, sh, h, &o->yo, fr, &lowered, NULL, NULL) != HSR_OK)) { rc = 1; goto out; }
+        || (o->lod_predict && yp_lod_fit_anim(lod, an, 0, h, sh, &o->yo, fr, &lowered, &coarsened, &fy0, &fy1) != HSR_OK)) { rc = 1; goto out; }
     if (lod) memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
     double t1 = now_ms();
     if (mkdir_p(o->out)) { rc = 1; goto out; }
@@ -413,6 +422,17 @@ static int anim_main(opts *o)
     fprintf(js, "{\"format\": \"yproc-anim-1\", \"anim\": \"%s\", \"frames\": %d, \"width\": %d, \"height\": %d, "
                 "\"capacity\": %d, \"lod_loop\": %d, \"lod_predict\": %d, \"no_degrade\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f",
             o->in, F, W, H, o->yo.capacity, o->lod_loop, o->lod_predict, o->yo.no_degrade, t1 - t0);
+    tess_json(js, an, coarsened);
+    for (int k = 0; k < yp_tess_count(yp_anim_tess(an)); k++) {
+        /* faces of each version (the scene's obj statements of the clustered meshes) */
+        fprintf(js, "%s[", k ? ", " : ", \"tess_faces\": [");
+        for (int v = 0; v < yp_tess_versions(yp_anim_tess(an), k); v++) {
+            int nfo = 0, ob = yp_tess_obj(yp_anim_tess(an), k, v);
+            for (int fi = 0; fi < sc->nf; fi++) nfo += sc->f[fi].obj == ob;
+            fprintf(js, "%s%d", v ? ", " : "", nfo);
+        }
+        fprintf(js, "]%s", k + 1 == yp_tess_count(yp_anim_tess(an)) ? "]" : "");
+    }
     if (lod_stats(js, fr, lod, o->yo.capacity, 0, o->monitor_stdin, lowered)) { rc = 1; fclose(js); goto out; }
     fprintf(js, "}");
     double sum_inc = 0, sum_full = 0, sum_inc_scan = 0, sum_full_scan = 0;
@@ -421,6 +441,9 @@ static int anim_main(opts *o)
     for (int f = 1; f < F && !rc; f++) {
         int y0, y1;
         double a0 = now_ms();
+        /* tessellation: an object whose lines are all back at full quality tries its finer
+         * mesh (the check below makes it coarser again if a line then does not fit) */
+        if (o->lod_predict && yp_anim_tess(an)) yp_tess_refine(yp_anim_tess(an), sc, h, yp_lod_levels(lod), f);
         st = yp_anim_apply(an, f, h, sh, &y0, &y1);
         /* lines whose level of detail changed are re-scanned too */
         for (int y = 0; lod && y < H; y++)
@@ -429,9 +452,9 @@ static int anim_main(opts *o)
         double am = now_ms();
         if (st == HSR_OK) st = yp_scan(sh, h, &o->yo, y0, y1, fr);
         /* the y-processor's own check: lines over the capacity lowered before they are emitted */
-        lowered = 0;
+        lowered = coarsened = 0;
         if (st == HSR_OK && o->lod_predict) {
-            st = yp_lod_fit(lod, sh, h, &o->yo, fr, &lowered, &y0, &y1);
+            st = yp_lod_fit_anim(lod, an, f, h, sh, &o->yo, fr, &lowered, &coarsened, &y0, &y1);
             memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
         }
         double a1 = now_ms();
@@ -478,6 +501,7 @@ static int anim_main(opts *o)
         for (int c = 0; c < 3; c++)
             for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chslots[c * H + y], y == H - 1 ? "]" : "");
         fprintf(js, "]");
+        tess_json(js, an, coarsened);
         if (lod_stats(js, fr, lod, o->yo.capacity, f, o->monitor_stdin, lowered)) { rc = 1; break; }
         fprintf(js, "}");
         printf("frame %3d: lines %3d..%3d rescanned, changed r/g/b %d/%d/%d; incremental %.1f ms (hsr %.1f + scan %.1f), "
