@@ -108,6 +108,14 @@ with the previous frame's line, counted by yproc), as a histogram and per frame.
 
     diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim] [--model fast|numpy]
 
+The Load Monitor loop (docs/yproc.md section 10): --lod-compare runs the animation four
+times (open loop, look-ahead, the loop, the loop with the check before emission) and plots
+overflowing lines and quality per frame; --lod-loop runs the loop once, with --predict the
+check before emission, with --rtl the Verilated display controller's Load Monitor read
+back frame by frame instead of yproc's model of it:
+
+    diffengine anim --anim A.anim --lod-loop --rtl [--htotal N] [--chips C] [--predict]
+
 Exit status 0 only if no frame differs from its full re-render.
 """
 
@@ -237,6 +245,8 @@ def lod_run_stats(d: Path) -> dict:
             "mean_level": [f["mean_level"] for f in fr],
             "max_issued": [max(f["issued"]) for f in fr],
             "levels": [f["levels"] for f in fr],
+            "lowered": [f.get("lowered_before_emit", 0) for f in fr],
+            "tess": [f["tess"] for f in fr] if "tess" in fr[0] else None,
             "capacity": st["capacity"], "mean_scan_ms": st["mean_incremental_scan_ms"]}
 
 
@@ -257,6 +267,16 @@ def plot_lod(res: dict, path, title: str) -> None:
     ax[0].set_ylabel("late (overflowing) lines")
     ax[0].set_title("overflowing lines per frame")
     ax[0].legend(fontsize=7)
+    tess = res.get("predict", {}).get("tess")
+    if tess:
+        # tessellation (yp_tess.c): the mesh version each object shows, 0 = its own mesh
+        tw = ax[1].twinx()
+        for k in range(len(tess[0])):
+            tw.step(range(len(tess)), [t[k] for t in tess], where="mid", color="#aa3377", ls="--",
+                    label=f"object {k}: mesh version shown (0 = finest)")
+        tw.set_ylabel("mesh version (predict run)", color="#aa3377")
+        tw.set_ylim(-0.2, max(max(t) for t in tess) + 1.5)
+        tw.legend(fontsize=7, loc="upper right")
     ax[1].set_xlabel("frame")
     ax[1].set_ylabel("mean level of detail (5 = full)")
     ax[1].set_title("quality per frame")
@@ -407,6 +427,8 @@ def configure(ap) -> None:
                          "(test-mode geometry, HTotal 800 unless 640x480; slow at full size)")
     ap.add_argument("--chips", type=int, help="with --rtl: chips per colour (default: the fewest "
                     "that cover the width)")
+    ap.add_argument("--htotal", type=int, help="with --rtl: the controller's HTotal in test mode, "
+                    "porches 4 + 8 (slots per line + 2; default 800, or the 640x480 mode)")
     ap.add_argument("--capacity", type=int, help="with --lod-loop: yproc's slots per line "
                     "(default: the mode's, or with --rtl the controller's HTotal - 2)")
     ap.set_defaults(func=command)
@@ -419,7 +441,14 @@ def command(a) -> int:
         print(f"anim: {a.anim}: the Load Monitor loop{' + check before emission' if a.predict else ''}"
               f"{', the Verilated controller in the loop' if a.rtl else ''}", flush=True)
         try:
-            st = lod_loop(a.anim, out / "loop", predict=a.predict, rtl=a.rtl, chips=a.chips,
+            test = None
+            if a.htotal:
+                # short porches (front 4, sync 8) as in the tests' short lines
+                W, H = anim_screen(a.anim)
+                test = (W, 4, 8, a.htotal - W - 12, H, 1, 2, 2)
+                if test[3] < 1:
+                    raise ValueError(f"--htotal {a.htotal} leaves no back porch for width {W}")
+            st = lod_loop(a.anim, out / "loop", predict=a.predict, rtl=a.rtl, chips=a.chips, test=test,
                           capacity=a.capacity, extra=("--mode", a.mode) if a.mode else ())
         except (RuntimeError, ValueError) as e:
             print(f"anim: error: {e}", file=sys.stderr)

@@ -36,9 +36,13 @@ void yp_lod_monitor(const int *slots, int n, int capacity, int *issued, int *lat
 {
     long drain = 0;   /* words of a late line still to be discarded (its marker included) */
     for (int l = 0; l < n; l++) {
-        long room = capacity + 1 - drain;          /* slots of this window after the discard */
-        drain = room < 0 ? -room : 0;
-        if (room < 0) room = 0;
+        /* slots of this window after the discard.  A discard longer than the window goes on
+         * through the line's last cycle, outside the window (HTotal = capacity + 2 cycles per
+         * line): in a cascade of late lines the tail shrinks by one word more per line than
+         * the window (found with the Verilated controller in the loop, docs/yproc.md 10) */
+        long room;
+        if (drain > capacity + 1) { room = 0; drain -= capacity + 2; }
+        else { room = capacity + 1 - drain; drain = 0; }
         int sl = slots[l];                          /* slots and issued may be one array */
         late[l] = sl + 1 > room;
         issued[l] = late[l] ? (int)room : sl;

@@ -259,8 +259,29 @@ static void test_tessellation_loop_coarser_when_overloaded_finer_when_load_falls
     ta_close(&t);
 }
 
+
+/* The monitor's model on a cascade of 81 late lines, against what the Verilated
+ * display_controller recorded (blue, frame 3 of lod_comb.anim at 160x120, HTotal 200:
+ * capacity 198; `diffengine anim --lod-loop --rtl --htotal 200`, 2026-11-26).  A discard
+ * longer than the window also takes the line's cycle outside it: the model without that
+ * said 7 words for line 109 (the RTL: 82) and line 110 late (the RTL: on time). */
+static void test_lod_monitor_equals_the_rtl_on_a_long_cascade(void)
+{
+    static const int slots[120] = {3,3,3,3,3,3,3,3,133,101,95,103,103,109,109,109,115,113,105,97,103,103,101,105,101,97,95,99,170,242,244,242,242,242,238,232,238,240,242,252,248,246,178,250,250,258,258,180,178,170,176,176,252,252,176,182,252,246,238,234,238,240,252,250,248,244,248,248,246,242,240,244,250,246,246,240,242,232,230,232,99,226,234,226,226,224,216,216,210,214,194,186,93,93,99,97,103,107,105,97,93,87,91,95,97,95,99,99,99,101,105,113,3,3,3,3,3,3,3,3};
+    static const int rtl_issued[120] = {3,3,3,3,3,3,3,3,133,101,95,103,103,109,109,109,115,113,105,97,103,103,101,105,101,97,95,99,170,199,155,109,65,21,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,82,105,113,3,3,3,3,3,3,3,3};
+    int is[120], lt[120], nlate = 0;
+    yp_lod_monitor(slots, 120, 198, is, lt);
+    for (int y = 0; y < 120; y++) {
+        CHECK(is[y] == rtl_issued[y]);
+        CHECK(lt[y] == (y >= 29 && y <= 109));
+        nlate += lt[y];
+    }
+    CHECK(nlate == 81);
+}
+
 void suite_yp_tess(void)
 {
+    RUN(test_lod_monitor_equals_the_rtl_on_a_long_cascade);
     RUN(test_lod_fit_no_late_line_from_frame_0_and_quality_back);
     RUN(test_tessellation_versions_cluster_and_switch_incrementally);
     RUN(test_tessellation_loop_coarser_when_overloaded_finer_when_load_falls);
