@@ -61,3 +61,38 @@ def test_monitor_stdin_rejects_a_bad_record(tmp_path):
                        capture_output=True, text=True)
     assert r.returncode == 2 and "needs --lod-loop" in r.stderr
     assert H == 16
+
+
+def _comb(tmp, tess: bool):
+    """lod_comb.anim at 48x24, 16 frames (the comb in at frames 0-3, out at 6-9), with or
+    without `tessellation 1 0.15 3` (versions of 64, then fewer teeth)."""
+    from pathlib import Path
+    from scene_files import scene_copy
+    repo = Path(__file__).resolve().parents[2]
+    scene_copy(repo / "sw/scenes/anim/lod_comb.scene", tmp / "lod_comb.scene", (48, 24))
+    a = tmp / f"comb{int(tess)}.anim"
+    a.write_text("scene lod_comb.scene\nframes 16\ntexture pattern 0.25 0.4 1 0.8 0.55 7 8\n"
+                 "pointlight 0 0.4 0.3 0.9 falloff 1.5\n" + ("tessellation 1 0.15 3\n" if tess else "")
+                 + "move 1 4.6 0 0 from 0 to 3\nmove 1 4.6 0 0 from 6 to 9\n")
+    return a
+
+
+def test_tessellation_ends_what_level_0_cannot_with_the_rtl_in_the_loop(tmp_path):
+    """The comb at 48x24 on an 80-slot line (HTotal 82): with the check alone, level 0 does
+    not fit while the comb is in view (late lines); with tessellation the comb goes to a
+    coarser version before the frame is emitted and the controller records no late line in
+    any frame, with the same decisions (levels and mesh versions) as on yproc's model."""
+    geom = (48, 4, 8, 82 - 60, 24, 1, 2, 2)
+    plain = anim.lod_loop(_comb(tmp_path, False), tmp_path / "plain", predict=True, capacity=80)
+    assert sum(f["overflow_lines"] for f in plain["frame"]) > 0          # level 0 is not enough
+    model = anim.lod_loop(_comb(tmp_path, True), tmp_path / "model", predict=True, capacity=80)
+    rtl = anim.lod_loop(_comb(tmp_path, True), tmp_path / "rtl", predict=True, rtl=True, chips=6,
+                        test=geom, log=lambda *_: None)
+    assert rtl["capacity"] == 80 and rtl["frames_played"] == 16
+    assert rtl["frames_differing_from_full"] == 0
+    assert rtl["frame"][0]["tess_faces"][0][0] == 64 and rtl["frame"][0]["tess_faces"][0][2] < 64
+    for f, (m, r) in enumerate(zip(model["frame"], rtl["frame"])):
+        assert r["overflow_lines"] == 0 and r["model_agrees"] == 1, f"frame {f}"
+        assert r["levels"] == m["levels"] and r["tess"] == m["tess"], f"frame {f}"
+    assert max(f["tess"][0] for f in rtl["frame"]) > 0                   # made coarser
+    assert sum(f["tess_coarsened"] for f in rtl["frame"]) > 0
