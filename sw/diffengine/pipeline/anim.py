@@ -402,6 +402,59 @@ def lod_loop(anim_path, out: Path, predict: bool = False, rtl: bool = False, chi
     return st
 
 
+def plot_lod_rtl(outs: list, path) -> dict:
+    """The Verilated controller in the loop against yproc's model (`--lod-loop --rtl
+    --compare-model` writes OUT/loop and OUT/loop_model): per OUT, late lines and mean level
+    per frame of both runs, the lines whose level differs between them, and the mesh version
+    where the animation has tessellation. Returns a summary per OUT (also lod_rtl.json)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
+    cols = ["#4477aa", "#228833", "#cc6677", "#ddaa33"]
+    summary = {}
+    for i, o in enumerate(map(Path, outs)):
+        A = json.loads((o / "loop" / "anim_stats.json").read_text())
+        B = json.loads((o / "loop_model" / "anim_stats.json").read_text())
+        col, name = cols[i % len(cols)], f"{Path(A['anim']).name}{' + check' if A.get('lod_predict') else ''}"
+        diff = [sum(a != b for a, b in zip(x["levels"], y["levels"])) for x, y in zip(A["frame"], B["frame"])]
+        summary[str(o)] = {"anim": A["anim"], "predict": A.get("lod_predict", 0),
+                           "late_lines": sum(f["overflow_lines"] for f in A["frame"]),
+                           "frames_model_agrees": sum(f.get("model_agrees", 0) for f in A["frame"]),
+                           "frames": len(A["frame"]), "level_differences": sum(diff),
+                           "tess_same": [f.get("tess") for f in A["frame"]] == [f.get("tess") for f in B["frame"]]}
+        ax[0].plot([f["overflow_lines"] for f in A["frame"]], color=col, marker=".", label=f"{name}: RTL")
+        ax[0].plot([f["overflow_lines"] for f in B["frame"]], color=col, ls=":", lw=3, alpha=.6,
+                   label=f"{name}: model")
+        ax[1].plot([f["mean_level"] for f in A["frame"]], color=col, marker=".")
+        ax[1].plot([f["mean_level"] for f in B["frame"]], color=col, ls=":", lw=3, alpha=.6)
+        ax[2].plot(diff, color=col, marker=".", label=name)
+        if "tess" in A["frame"][0]:
+            tw = ax[1].twinx()
+            tw.step(range(len(A["frame"])), [f["tess"][0] for f in A["frame"]], where="mid", color="#aa3377",
+                    ls="--", label=f"{name}: mesh version (RTL run)")
+            tw.set_ylim(-0.2, 3)
+            tw.set_ylabel("mesh version", color="#aa3377")
+            tw.legend(fontsize=7, loc="upper right")
+    ax[0].set_title("late lines per frame (the controller's record)")
+    ax[0].set_xlabel("frame")
+    ax[0].legend(fontsize=6, loc="upper right")
+    ax[1].set_title("mean level per frame")
+    ax[1].set_xlabel("frame")
+    ax[1].set_ylim(0, 5.3)
+    ax[2].set_title("lines whose level differs, RTL against model")
+    ax[2].set_xlabel("frame")
+    ax[2].set_ylim(-0.5, 5)
+    ax[2].legend(fontsize=7)
+    fig.suptitle("The Verilated display controller's Load Monitor read back every frame "
+                 "(dotted: the same animation on yproc's model)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    Path(path).with_suffix(".json").write_text(json.dumps(summary, indent=1) + "\n")
+    return summary
+
+
 def configure(ap) -> None:
     """The arguments of `diffengine anim` (make anim)."""
     ap.epilog = COMMAND_HELP
@@ -427,6 +480,12 @@ def configure(ap) -> None:
                          "(test-mode geometry, HTotal 800 unless 640x480; slow at full size)")
     ap.add_argument("--chips", type=int, help="with --rtl: chips per colour (default: the fewest "
                     "that cover the width)")
+    ap.add_argument("--compare-model", action="store_true",
+                    help="with --lod-loop --rtl: also the same run on yproc's model (OUT/loop_model) "
+                         "and the comparison OUT/lod_rtl.png, lod_rtl.json")
+    ap.add_argument("--plot-rtl", nargs="+", metavar="OUT",
+                    help="instead: one plot of several --lod-loop --rtl --compare-model outputs -> "
+                         "--out/lod_rtl.png")
     ap.add_argument("--htotal", type=int, help="with --rtl: the controller's HTotal in test mode, "
                     "porches 4 + 8 (slots per line + 2; default 800, or the 640x480 mode)")
     ap.add_argument("--capacity", type=int, help="with --lod-loop: yproc's slots per line "
@@ -437,6 +496,12 @@ def configure(ap) -> None:
 def command(a) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.plot_rtl:
+        summary = plot_lod_rtl(a.plot_rtl, out / "lod_rtl.png")
+        for k, v in summary.items():
+            print(f"  {k}: {v}")
+        print(f"wrote {out / 'lod_rtl.png'}")
+        return 0
     if a.lod_loop:
         print(f"anim: {a.anim}: the Load Monitor loop{' + check before emission' if a.predict else ''}"
               f"{', the Verilated controller in the loop' if a.rtl else ''}", flush=True)
@@ -460,6 +525,13 @@ def command(a) -> int:
         if a.rtl:
             print(f"  the controller's record equals yproc's model in {sum(agree)} of {len(agree)} "
                   f"frames; RTL {st['rtl_seconds']:.0f} s for {st['frames_played']} frames")
+        if a.rtl and a.compare_model:
+            lod_loop(a.anim, out / "loop_model", predict=a.predict, capacity=st["capacity"],
+                     extra=("--mode", a.mode) if a.mode else ())
+            summary = plot_lod_rtl([out], out / "lod_rtl.png")[str(out)]
+            print(f"  the same on yproc's model: lines whose level differs {summary['level_differences']}, "
+                  f"mesh versions the same: {summary['tess_same']} ({out / 'lod_rtl.png'})")
+            agree.append(summary["level_differences"] == 0 and summary["tess_same"])
         print(f"wrote {out / 'loop'}")
         return 0 if st["frames_differing_from_full"] == 0 and all(agree) else 1
     if a.lod_compare:
