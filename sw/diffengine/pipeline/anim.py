@@ -115,6 +115,8 @@ check before emission, with --rtl the Verilated display controller's Load Monito
 back frame by frame instead of yproc's model of it:
 
     diffengine anim --anim A.anim --lod-loop --rtl [--htotal N] [--chips C] [--predict]
+                    [--compare-model]      # + the same on the model, OUT/lod_rtl.png
+    diffengine anim --plot-rtl OUT1 OUT2 ... --out DIR   # several of those in one plot
 
 Exit status 0 only if no frame differs from its full re-render.
 """
