@@ -58,6 +58,13 @@
 // part, which can only flag a legal ACT, never pass an illegal one); an
 // auto-precharge that would start before tRAS is a TRAS violation (no tRAS lockout
 // assumed); unwritten locations read as UninitWord.
+//
+// Preload (simulation back door, docs/sdram-frames-spec.md §5): PreloadFile, or the file
+// named by +sdram_image=<path>, holds text lines "<addr> <word>" in hex, '#' starting a
+// comment: addr is the controller's word address {bank, row, column[ColBits-1:1]}, word
+// 32 bits, stored as two 16-bit columns, [15:0] at the even column and [31:16] at the odd
+// one. It is read once; every power-on (initial, rst_i) starts from that image instead
+// of an empty memory. A malformed line is a $fatal naming the file and line.
 `default_nettype none
 // A behavioural model: blocking assignments inside the clocked process are its sequential
 // program (outputs to the controller go out through <= at the end, so there is no race),
@@ -88,6 +95,7 @@ module sdram_sdr16 #(
   parameter int unsigned      TinitNs     = 100_000,        // 100 us power-up wait
   parameter logic [15:0]      UninitWord  = 16'h0000,
   parameter string            LogFile     = "",             // "" = stdout only
+  parameter string            PreloadFile = "",             // "" = +sdram_image= or none
   parameter bit               Verbose     = 1'b1,           // print each violation
   localparam int unsigned     AddrBits    = (RowBits > ColBits + 2) ? RowBits : ColBits + 2
 ) (
@@ -150,6 +158,7 @@ module sdram_sdr16 #(
   // --------------------------------------------------------------------------------
   // State.
   logic [15:0] mem [int unsigned];      // sparse: {bank, row, col} -> word
+  logic [15:0] pre [int unsigned];      // the preload image, the contents at power-on
   int          last_act_bank;
 
   longint    cyc;                        // index of the current edge
@@ -246,7 +255,7 @@ module sdram_sdr16 #(
   endfunction
 
   task automatic power_on();
-    mem.delete();
+    mem = pre;
     cyc = -1;
     for (int b = 0; b < NBanks; b++) begin
       active[b]  = 1'b0;
@@ -580,13 +589,82 @@ module sdram_sdr16 #(
     end
   endtask
 
+  // The preload file (see the header): {addr, word} lines -> two 16-bit columns each.
+  localparam int unsigned WordAddrBits = BankBits + RowBits + ColBits - 1;
+  // A hex number of at most 16 digits; 0 if `t` is not one.
+  function automatic bit parse_hex(input string t, output logic [63:0] v);
+    v = '0;
+    if (t.len() == 0 || t.len() > 16) return 1'b0;
+    for (int i = 0; i < t.len(); i++) begin
+      byte ch;
+      ch = t[i];
+      if (ch >= "0" && ch <= "9")      v = (v << 4) | 64'(ch - "0");
+      else if (ch >= "a" && ch <= "f") v = (v << 4) | 64'(ch - "a" + 10);
+      else if (ch >= "A" && ch <= "F") v = (v << 4) | 64'(ch - "A" + 10);
+      else return 1'b0;
+    end
+    return 1'b1;
+  endfunction
+
+  task automatic read_preload(input string path);
+    int    fd, lineno, words, ntok;
+    string line, tok [3];
+    logic [63:0] a, w;
+    fd = $fopen(path, "r");
+    if (fd == 0) $fatal(1, "sdram_sdr16: %s: cannot open the preload file", path);
+    lineno = 0;
+    words  = 0;
+    while (!$feof(fd)) begin
+      line = "";
+      if ($fgets(line, fd) == 0) break;
+      lineno++;
+      while (line.len() > 0 && (line[line.len() - 1] == "\n" || line[line.len() - 1] == "\r"))
+        line = line.substr(0, line.len() - 2);
+      // Tokens up to the comment.
+      ntok = 0;
+      tok[0] = "";
+      tok[1] = "";
+      tok[2] = "";
+      for (int i = 0; i < line.len(); i++) begin
+        byte ch;
+        ch = line[i];
+        if (ch == "#") break;
+        if (ch == " " || ch == "\t" || ch == "\n" || ch == "\r") begin
+          if (ntok < 3 && tok[ntok] != "") ntok++;
+        end else if (ntok < 3) begin
+          tok[ntok] = {tok[ntok], string'(ch)};
+        end else begin
+          ntok = 4;
+        end
+      end
+      if (ntok < 3 && tok[ntok] != "") ntok++;
+      if (ntok == 0) continue;
+      if (ntok != 2 || !parse_hex(tok[0], a) || !parse_hex(tok[1], w)) begin
+        $fatal(1, "sdram_sdr16: %s:%0d: want '<addr> <word>' in hex, got '%s'", path,
+               lineno, line);
+      end
+      if (a >> WordAddrBits != 0 || w >> 32 != 0) begin
+        $fatal(1, "sdram_sdr16: %s:%0d: address %0h (%0d bits) or word %0h (32 bits) out of range",
+               path, lineno, a, WordAddrBits, w);
+      end
+      pre[uint_t'(a) << 1]          = w[15:0];
+      pre[(uint_t'(a) << 1) | 1'b1] = w[31:16];
+      words++;
+    end
+    $fclose(fd);
+    $display("sdram_sdr16: preloaded %0d words (%0d lines) from %s", words, lineno, path);
+  endtask
+
   // The log file: LogFile, or +sdram_log=<path> on the simulator's command line.
-  string log_name;
+  string log_name, image_name;
   initial begin
     log_fd   = 0;
     log_name = LogFile;
     void'($value$plusargs("sdram_log=%s", log_name));
     if (log_name != "") log_fd = $fopen(log_name, "w");
+    image_name = PreloadFile;
+    void'($value$plusargs("sdram_image=%s", image_name));
+    if (image_name != "") read_preload(image_name);
     power_on();
     dq_o    = '0;
     dq_oe_o = 1'b0;

@@ -624,6 +624,40 @@ def _run(build: str) -> None:
     runner.test(hdl_toplevel="sdram_sdr16", test_module="test_sdram_model",
                 build_dir=build_dir, test_dir=HERE, extra_env=env,
                 plusargs=[f"+sdram_log={log}"], results_xml=str(build_dir / "results.xml"))
+    if build == "tck8000":
+        _run_preload(runner, build_dir, env)
+
+
+def _run_preload(runner, build_dir: Path, env: dict) -> None:
+    """The back-door preload (test_sdram_preload.py) on the same build: a random image
+    (SEED replays it) read back through READs; then a malformed image must stop the
+    simulation with an error naming the file and line."""
+    import json
+    import subprocess
+
+    from test_sdram_preload import write_image
+    s = int(os.environ.get("SEED", random.randrange(1 << 30)))
+    print(f"SEED={s}")
+    image = build_dir / "preload.hex"
+    words = write_image(image, random.Random(s))
+    (build_dir / "preload.json").write_text(json.dumps({str(a): w for a, w in words.items()}))
+    results = build_dir / "results_preload.xml"
+    runner.test(hdl_toplevel="sdram_sdr16", test_module="test_sdram_preload",
+                build_dir=build_dir, test_dir=HERE, results_xml=str(results),
+                extra_env=dict(env, SDRAM_IMAGE_JSON=str(build_dir / "preload.json")),
+                plusargs=[f"+sdram_log={build_dir / 'preload.log'}", f"+sdram_image={image}"])
+    text = results.read_text()
+    assert 'name="preload"' in text and "<failure" not in text, text
+    # A malformed line: the model's $fatal names file and line (run the simulator binary
+    # directly: no cocotb test is needed for an error at time 0).
+    bad = build_dir / "bad.hex"
+    bad.write_text("# ok\n000010 12345678\n000011 zz\n")
+    exe = build_dir / "sdram_sdr16"                     # the runner's -o
+    r = subprocess.run([str(exe), f"+sdram_image={bad}"], capture_output=True, text=True,
+                       timeout=60, env=dict(os.environ, COCOTB_TEST_MODULES="test_sdram_preload",
+                                            TOPLEVEL="sdram_sdr16", SDRAM_IMAGE_JSON="-"))
+    out = r.stdout + r.stderr
+    assert r.returncode != 0 and f"{bad}:3: want '<addr> <word>' in hex" in out, out
 
 
 try:
