@@ -284,7 +284,7 @@ def coherence_sweep(anim_path, out: Path, frames: int = 10, legs=SWEEP_LEGS, run
     yproc = build_yproc()
     res = []
     for tol, coh, aa in runs:
-        for leg in (legs if coh else (legs[0], legs[-1])):
+        for leg in (legs if coh else sorted({legs[0], legs[-1]})):
             name = f"t{tol}_l{leg}_{'coh' if coh else 'plain'}{'' if aa else '_noaa'}"
             a = anim_variant(anim_path, out / f"{name}.anim", frames, leg)
             t0 = time.time()
