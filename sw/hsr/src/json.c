@@ -29,17 +29,18 @@ static hsr_status put_rings(FILE *f, const hsr_domain *d)
     return HSR_OK;
 }
 
-/* The head both domain dumps share, up to the opening of their list (named list); NULL
- * when the file cannot be written. */
-static FILE *open_dump(const char *path, const hsr_ctx *h, const hsr_scene *sc,
-                       const char *format, const char *list)
+/* The start both domain dumps share: the arguments checked, the file opened (*f) and
+ * written up to the opening of its list (named list). */
+static hsr_status open_dump(FILE **f, const char *path, const hsr_ctx *h, const hsr_scene *sc,
+                            const char *format, const char *list)
 {
-    FILE *f = fopen(path, "w");
-    if (f)
-        fprintf(f, "{\"format\": \"%s\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
-                   " \"mlr_count\": %d, \"%s\": [", format, HSR_SUBPIXEL, sc->width, sc->height,
-                hsr_mlr_slots(h), list);
-    return f;
+    if (!path || !h || !sc) return HSR_EINVAL;
+    *f = fopen(path, "w");
+    if (!*f) return HSR_EIO;
+    fprintf(*f, "{\"format\": \"%s\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
+                " \"mlr_count\": %d, \"%s\": [", format, HSR_SUBPIXEL, sc->width, sc->height,
+            hsr_mlr_slots(h), list);
+    return HSR_OK;
 }
 
 /* ... and its end: the list closed, the file closed; st, or HSR_EIO if closing failed. */
@@ -52,11 +53,10 @@ static hsr_status close_dump(FILE *f, hsr_status st)
 
 hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
 {
-    if (!path || !h || !sc) return HSR_EINVAL;
-    FILE *f = open_dump(path, h, sc, "hsr-llr-1", "domains");
-    if (!f) return HSR_EIO;
+    FILE *f;
+    hsr_status st = open_dump(&f, path, h, sc, "hsr-llr-1", "domains");
+    if (st != HSR_OK) return st;
     const double S = HSR_SUBPIXEL;
-    hsr_status st = HSR_OK;
     int first = 1;
     for (int s = 0; s < hsr_llr_slots(h) && st == HSR_OK; s++) {
         const hsr_domain *d; const int *par; int nv, np;
@@ -81,11 +81,10 @@ hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scen
  * docs/hsr.md; used by sw/tests/test_hsr_oracle.py). */
 hsr_status hsr_write_input_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
 {
-    if (!path || !h || !sc) return HSR_EINVAL;
-    FILE *f = open_dump(path, h, sc, "hsr-input-1", "polygons");
-    if (!f) return HSR_EIO;
+    FILE *f;
+    hsr_status st = open_dump(&f, path, h, sc, "hsr-input-1", "polygons");
+    if (st != HSR_OK) return st;
     const double S = HSR_SUBPIXEL;
-    hsr_status st = HSR_OK;
     for (int id = 0, first = 1; id < hsr_mlr_slots(h) && st == HSR_OK; id++) {
         const hsr_domain *d; hsr_plane pl; double op;
         if (!hsr_mlr_get(h, id, &d, &pl, &op, NULL, NULL)) continue;   /* removed (--ops) */
