@@ -77,7 +77,7 @@ module de_chip_core
   input  link_t            link_i,       // .coll not used
   /* verilator lint_on UNUSEDSIGNAL */
   output link_t            link_o,       // combinational: the last PE's bus (or bypass),
-                                         // pix_i OR the PEs' pixels, two pixels met here
+                                         // its pixel OR the PEs' pixels, two pixels met here
   input  chain_ctl_t       chain_ctl_i,
   input  chain_t           chain_i,
   output chain_t           chain_o,
