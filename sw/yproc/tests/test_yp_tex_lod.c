@@ -33,7 +33,12 @@ static void make_pattern_files(void)
  * textures unless ext), HSR built, a frame, default options */
 typedef struct tanim { yp_anim *an; hsr_scene *sc; yp_shader *sh; hsr_ctx *h; yp_frame *fr; yp_options o; int W, H; } tanim;
 
-static int tanim_open(tanim *t, const char *path, int ext)
+static void tanim_close(tanim *t)
+{
+    yp_frame_free(t->fr); hsr_destroy(t->h); yp_shader_free(t->sh); yp_anim_free(t->an);
+}
+
+static int tanim_make(tanim *t, const char *path, int ext)
 {
     memset(t, 0, sizeof *t);
     char err[256] = "";
@@ -48,17 +53,20 @@ static int tanim_open(tanim *t, const char *path, int ext)
     return yp_frame_new(t->W, t->H, &t->fr) == HSR_OK;
 }
 
-static void tanim_close(tanim *t)
+/* tanim_make, a test failure when it fails (and what it made freed): 0 then. */
+static int tanim_open(tanim *t, const char *path, int ext)
 {
-    yp_frame_free(t->fr); hsr_destroy(t->h); yp_shader_free(t->sh); yp_anim_free(t->an);
+    const int ok = tanim_make(t, path, ext);
+    CHECK(ok);
+    if (!ok) tanim_close(t);
+    return ok;
 }
 
 static void test_texture_is_c1_piecewise_quadratic_along_u(void)
 {
     make_pattern_files();
     tanim ta;
-    CHECK(tanim_open(&ta, "build/t_tex.anim", 1));
-    if (!ta.fr) { tanim_close(&ta); return; }
+    if (!tanim_open(&ta, "build/t_tex.anim", 1)) return;
     yp_shader *sh = ta.sh;
     char err[256] = "";
     CHECK(yp_texture_at(sh, 0, (double[3]){0, 0, 0}) >= 0);
@@ -132,8 +140,7 @@ static void test_wander_moves_continuously_towards_random_points_in_its_box(void
     write_file("build/t_w.anim", "scene t_tex.scene\nframes 40\npointlight 0 0.4 0.3 0.9\n"
                "wander 0 99 5 -1.8 -1.3 0.5 1.8 1.3 1.2 from 0 to 39\n");
     tanim ta;
-    CHECK(tanim_open(&ta, "build/t_w.anim", 1));
-    if (!ta.fr) { tanim_close(&ta); return; }
+    if (!tanim_open(&ta, "build/t_w.anim", 1)) return;
     yp_anim *an = ta.an;
     yp_shader *sh = ta.sh;
     char err[256] = "";
@@ -220,8 +227,7 @@ static void textured_run(const char *path, double tol, int coherent, long *chang
 {
     tanim t;
     *changed = *total = 0; *worst = 0;
-    CHECK(tanim_open(&t, path, 1));
-    if (!t.fr) { tanim_close(&t); return; }
+    if (!tanim_open(&t, path, 1)) return;
     int H = t.H, W = t.W;
     double *shade;
     t.o.tol = tol; t.o.coherent = coherent;
@@ -261,8 +267,7 @@ static void test_textured_anim_changes_only_the_light_terms(void)
 {
     make_pattern_files();
     tanim t;
-    CHECK(tanim_open(&t, "build/t_tex.anim", 0));
-    if (!t.fr) { tanim_close(&t); return; }
+    if (!tanim_open(&t, "build/t_tex.anim", 0)) return;
     yp_frame *fr = t.fr, *plain = NULL;
     int H = t.H, W = t.W;
     CHECK(yp_frame_new(W, H, &plain) == HSR_OK);
@@ -370,8 +375,7 @@ static void test_lod_loop_removes_overflow_and_restores_quality(void)
                "obj t_plate.obj material plate\nobj t_grid.obj material tile\n");
     write_file("build/t_grid.anim", "scene t_grid.scene\nframes 14\nmove 1 5 0 0 from 6 to 9\n");
     tanim t;
-    CHECK(tanim_open(&t, "build/t_grid.anim", 1));
-    if (!t.fr) { tanim_close(&t); return; }
+    if (!tanim_open(&t, "build/t_grid.anim", 1)) return;
     yp_shader *sh = t.sh;
     hsr_ctx *h = t.h;
     yp_frame *fr = t.fr;
