@@ -95,7 +95,7 @@ module de_pe
   // ---- stage 1 address decision (needed first: it sets act for stage 0) --------------
   // An address slot fires when, periodic, its countdown (block 1) is 0, or, range, X was
   // 0 (xz1_q) and dX (block 1) is not: fire1 = id1.addr && (per1 ? z1 : xz1_q && !z1).
-  logic z1, per1, fire_rng1, act_eff;
+  logic z1, per1, act_eff;
   // The zero test in two kept halves of 6 bits: each is two LUT levels (in a chip, each
   // input bit is also the OR of the PE and the bypass register), and act_eff then needs
   // one LUT4 of both halves and aez_q/aenz_q instead of a third level of the test.
@@ -104,7 +104,6 @@ module de_pe
   assign z1_hi     = (in_blk[1][BlkW-1:BlkW/2] == '0);
   assign z1        = z1_lo && z1_hi;
   assign per1      = id1.addr && (id1.sub == SubPeriodic);
-  assign fire_rng1 = id1.addr && xz1_q && !z1;
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
   // sees that slot's decision at once; later slots of the command see the act register:
   // act_eff = id1.addr ? fire1 : act_q. Everything in it but the zero test of block 1 is
@@ -139,16 +138,20 @@ module de_pe
   logic live;
   assign live = !bypass_i;
 
+  // out0 = sum0 ? s0 : pass0. The select and the pass value are kept as nets of their
+  // own, so that the last LUT in front of out_q[0] has the five inputs sum0, pv0, sp0,
+  // sn0, pass0 (one PFUMX) rather than a 7-input function of the decisions.
+  (* keep *) logic sum0;
+  (* keep *) logic [BlkW-1:0] pass0;
+  assign sum0 = active0 && live;
   always_comb begin
-    out0 = in_blk[0];
+    pass0 = in_blk[0];
     if (rng0 && live) begin
       // Relative addressing: count X down to 0 and keep it there.
-      out0 = xz0 ? '0 : in_blk[0] - BlkW'(1);
-    end
-    if (active0 && live) begin
-      out0 = s0[BlkW-1:0];
+      pass0 = xz0 ? '0 : in_blk[0] - BlkW'(1);
     end
   end
+  assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
 
   // ---- stage 1: block 1 ------------------------------------------------------------------
   logic ev1, active1, wr1, dis1, e0_1, e0en1;
@@ -170,19 +173,21 @@ module de_pe
   assign e0_1    = e0x_q && !z1;
   assign e0en1   = e0_1 && !lock_q && !dis_q;
 
-  always_comb begin
-    out1 = in_blk[1];
-    if (per1 && live) begin
-      // Periodic: reload the countdown with P-1 from out_q block 0, which still holds
-      // the period this slot passed on unchanged one cycle ago (no extra register).
-      out1 = z1 ? out_q[0] - BlkW'(1) : in_blk[1] - BlkW'(1);
-    end else if (fire_rng1 && live) begin
-      out1 = in_blk[1] - BlkW'(1);
-    end
-    if (active1 && live) begin
-      out1 = s1[BlkW-1:0];
-    end
-  end
+  // out1 = sum1 ? s1 : pass1, select and pass value kept as nets, as in stage 0.
+  // An address slot decrements block 1 (the countdown, or dX when X was 0) unless it is
+  // 0; then a periodic slot reloads P-1 from out_q block 0, which still holds the period
+  // this slot passed on unchanged one cycle ago (no extra register), and any other slot
+  // passes the 0. The decrement subtracts dec1 (not a mux after it): one carry chain.
+  (* keep *) logic sum1;
+  (* keep *) logic [BlkW-1:0] pass1;
+  logic dec1;
+  logic [BlkW-1:0] q1, d1;
+  assign sum1  = active1 && live;
+  assign dec1  = live && (per1 || (id1.addr && xz1_q));
+  assign d1    = in_blk[1] - BlkW'(dec1);
+  assign q1    = (per1 && live) ? out_q[0] - BlkW'(1) : '0;
+  assign pass1 = z1 ? q1 : d1;
+  assign out1  = sum1 ? s1[BlkW-1:0] : pass1;
 
   // ---- stage 2: block 2 ------------------------------------------------------------------
   logic ev2, active2, wr2;
@@ -369,7 +374,7 @@ module de_pe
   assign xz1_d    = rng0 && xz0;
   assign act1_d   = act_eff;
   assign prot1_d  = prot0;
-  assign c1_d     = active0 && s0[BlkW];
+  assign c1_d     = sum0 && s0[BlkW];     // = active0 && s0[BlkW] (in bypass c1_q is held in reset)
   assign act2_d   = act1_q;
   assign prot2_d  = prot1_q;
   assign c2_d     = active1 && s1[BlkW];
