@@ -10,9 +10,9 @@
 // Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
 // PE's place is taken by a register on the bus and on the pixel chain (the source's
 // bypass is a wire; registered here so that the chip's clock does not depend on how many
-// PEs are bypassed in a row) and the PE is held in reset (no pixel, zero outputs, an
-// all-zero observation word); relative addressing makes the remaining PEs a smaller
-// array, one clock later per bypassed PE.
+// PEs are bypassed in a row; on the bus it is the PE's own output register) and the rest
+// of the PE is held in reset (no pixel, an all-zero observation word); relative
+// addressing makes the remaining PEs a smaller array, one clock later per bypassed PE.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
 // (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
 `default_nettype none
@@ -87,9 +87,9 @@ module de_chip
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
-// pass through bypass muxes and OR gates only (the PEs' own outputs and the bypass
-// registers are registered); the bus path crosses one mux, the pixel chain the OR gates
-// of the PEs in use since the last bypass register.
+// pass through no logic but a gated OR (the PEs' own outputs and the pixel bypass
+// registers are registered); the bus path crosses none, the pixel chain one OR of its
+// sources, each gated by a registered reach bit.
 /* verilator lint_off DECLFILENAME */
 module de_chip_core
   import de_pkg::*;

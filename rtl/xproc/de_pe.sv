@@ -96,9 +96,8 @@ module de_pe
   // An address slot fires when, periodic, its countdown (block 1) is 0, or, range, X was
   // 0 (xz1_q) and dX (block 1) is not: fire1 = id1.addr && (per1 ? z1 : xz1_q && !z1).
   logic z1, per1, act_eff;
-  // The zero test in two kept halves of 6 bits: each is two LUT levels (in a chip, each
-  // input bit is also the OR of the PE and the bypass register), and act_eff then needs
-  // one LUT4 of both halves and aez_q/aenz_q instead of a third level of the test.
+  // The zero test in two kept halves of 6 bits, so that act_eff is one LUT4 of both halves
+  // and aez_q/aenz_q rather than one more level behind a 12-bit test.
   (* keep *) logic z1_lo, z1_hi;
   assign z1_lo     = (in_blk[1][BlkW/2-1:0] == '0);
   assign z1_hi     = (in_blk[1][BlkW-1:BlkW/2] == '0);
@@ -359,7 +358,8 @@ module de_pe
   assign aenz_d = id0.addr ? xz1_d : act_d;
   assign disx_d = xz1_d && (id0.sub == SubDis);
   assign e0x_d  = xz1_d && (id0.sub == SubEval0);
-  // The slot in stage 0 (1) reads block 1 (2) next cycle, after this cycle's writes.
+  // wr1/wr2 are wr0/wr1 one cycle on; the slot in stage 0 (1) reads block 1 (2) next
+  // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
   assign wr1_d  = wr0;
   assign wr2_d  = wr1;
   assign src1_d = reg_blk(id0.src, a_d[1], b_d[1], c_d[1]);
