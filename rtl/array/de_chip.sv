@@ -1,7 +1,8 @@
 // Difference Engine: one chip of nine x-processors (Kuijk 1995, 7.4.5, Fig. 7.7).
 //
 // Bus:    id/data (skewed blocks) -> PE 0 -> ... -> PE 8 -> boundary register -> out.
-// Pixels: pix_i (from the upstream chip) OR the nine PEs' pixels -> boundary register.
+// Pixels: the upstream chip's pixel OR the nine PEs' pixels -> boundary register.
+// Both travel with the collision flag in one de_pkg::link_t (link_i -> link_o).
 // The boundary registers keep the combinational depth independent of the chip count.
 // Because both buses gain exactly one register per chip, a pixel of column q leaves the
 // last chip at (Refresh entry) + q + NumChips + const for every q: raster order with no
@@ -10,11 +11,11 @@
 // Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
 // PE's place is taken by a register on the bus and on the pixel chain (the source's
 // bypass is a wire; registered here so that the chip's clock does not depend on how many
-// PEs are bypassed in a row) and the PE is held in reset (no pixel, zero outputs, an
-// all-zero observation word); relative addressing makes the remaining PEs a smaller
-// array, one clock later per bypassed PE.
+// PEs are bypassed in a row; on the bus it is the PE's own output register) and the rest
+// of the PE is held in reset (no pixel, an all-zero observation word); relative
+// addressing makes the remaining PEs a smaller array, one clock later per bypassed PE.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
-// (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
+// (flags, stage-1 identifier, control pipeline) on obs_load and shifts them out.
 `default_nettype none
 
 module de_chip
@@ -27,27 +28,18 @@ module de_chip
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
-  input  logic [IdW-1:0]   id_i,
-  input  logic [DataW-1:0] data_i,
-  output logic [IdW-1:0]   id_o,
-  output logic [DataW-1:0] data_o,
-  input  logic             pix_valid_i,
-  input  logic [PixW-1:0]  pix_i,
-  output logic             pix_valid_o,
-  output logic [PixW-1:0]  pix_o,
-  // configuration chain: shifts one bit per clock while cfg_mode_i
-  input  logic             cfg_mode_i,
-  input  logic             cfg_bit_i,
-  output logic             cfg_bit_o,
-  // observation chain: parallel load on obs_load_i, shift one bit per clock on obs_shift_i
-  input  logic             obs_load_i,
-  input  logic             obs_shift_i,
-  input  logic             obs_bit_i,
-  output logic             obs_bit_o,
-  output logic [NumPe-1:0] bypass_o,    // current configuration, for tests and waves
-  // Two pixels met on the chain this cycle (registered): two Refreshes were closer
-  // than the array is wide, breaking "one Refresh active at a time" (7.4.1).
-  output logic             collision_o
+  // The bus and pixel chain from the upstream chip (its coll is not used: the array ORs
+  // the chips' flags) and to the next, registered. link_o.coll: two pixels met on the
+  // chain this cycle (registered): two Refreshes were closer than the array is wide,
+  // breaking "one Refresh active at a time" (7.4.1).
+  input  link_t            link_i,
+  output link_t            link_o,
+  // configuration chain: shifts one bit per clock while chain_ctl_i.cfg_mode;
+  // observation chain: parallel load on .obs_load, shift one bit per clock on .obs_shift
+  input  chain_ctl_t       chain_ctl_i,
+  input  chain_t           chain_i,
+  output chain_t           chain_o,
+  output logic [NumPe-1:0] bypass_o     // current configuration, for tests and waves
 );
   // Keep the chip a module of its own in Verilator's C++: the 72 instances then share one
   // class instead of flattening 648 PEs into one 90 MB root (build time 11 -> 2 min for 72 chips on 2 cores).
@@ -57,39 +49,20 @@ module de_chip
   // output) followed by the boundary registers. The split lets the fast simulation
   // (sim/fast, docs/simulation.md) cut the array at the registers and compile one chip
   // once; the logic is the same either way.
-  logic [IdW-1:0]   core_id;
-  logic [DataW-1:0] core_data;
-  logic             core_pixv, core_coll;
-  logic [PixW-1:0]  core_pix;
+  link_t core_link;
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .FaultMask(FaultMask)) u_core (
-    .clk_i, .rst_i, .id_i, .data_i, .pix_valid_i, .pix_i,
-    .id_o       (core_id),
-    .data_o     (core_data),
-    .pix_valid_o(core_pixv),
-    .pix_o      (core_pix),
-    .coll_o     (core_coll),
-    .cfg_mode_i, .cfg_bit_i, .cfg_bit_o,
-    .obs_load_i, .obs_shift_i, .obs_bit_i, .obs_bit_o,
-    .bypass_o
+    .clk_i, .rst_i, .link_i, .chain_ctl_i, .chain_i, .chain_o, .bypass_o,
+    .link_o(core_link)
   );
 
-  de_chip_bound u_bound (
-    .clk_i, .rst_i,
-    .id_i       (core_id),
-    .data_i     (core_data),
-    .pix_valid_i(core_pixv),
-    .pix_i      (core_pix),
-    .coll_i     (core_coll),
-    .id_o, .data_o, .pix_valid_o, .pix_o,
-    .coll_o     (collision_o)
-  );
+  de_chip_bound u_bound (.clk_i, .rst_i, .link_i(core_link), .link_o);
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
-// pass through bypass muxes and OR gates only (the PEs' own outputs and the bypass
-// registers are registered); the bus path crosses one mux, the pixel chain the OR gates
-// of the PEs in use since the last bypass register.
+// pass through no logic but a gated OR (the PEs' own outputs and the pixel bypass
+// registers are registered); the bus path crosses none, the pixel chain one OR of its
+// sources, each gated by a registered reach bit.
 /* verilator lint_off DECLFILENAME */
 module de_chip_core
   import de_pkg::*;
@@ -100,22 +73,14 @@ module de_chip_core
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
-  input  logic [IdW-1:0]   id_i,
-  input  logic [DataW-1:0] data_i,
-  output logic [IdW-1:0]   id_o,         // combinational: the last PE's bus (or bypass)
-  output logic [DataW-1:0] data_o,
-  input  logic             pix_valid_i,
-  input  logic [PixW-1:0]  pix_i,
-  output logic             pix_valid_o,  // combinational: pix_i OR the PEs' pixels
-  output logic [PixW-1:0]  pix_o,
-  output logic             coll_o,       // combinational: two pixels met in this chip
-  input  logic             cfg_mode_i,
-  input  logic             cfg_bit_i,
-  output logic             cfg_bit_o,
-  input  logic             obs_load_i,
-  input  logic             obs_shift_i,
-  input  logic             obs_bit_i,
-  output logic             obs_bit_o,
+  /* verilator lint_off UNUSEDSIGNAL */
+  input  link_t            link_i,       // .coll not used
+  /* verilator lint_on UNUSEDSIGNAL */
+  output link_t            link_o,       // combinational: the last PE's bus (or bypass),
+                                         // its pixel OR the PEs' pixels, two pixels met here
+  input  chain_ctl_t       chain_ctl_i,
+  input  chain_t           chain_i,
+  output chain_t           chain_o,
   output logic [NumPe-1:0] bypass_o
 );
   // Observation word per PE: {pA,pB,pC,dis,lock,acc_mode,act,id1} and the 12 control
@@ -133,14 +98,16 @@ module de_chip_core
   logic [NumPe:0][DataW-1:0] bus_data;
   logic [NumPe:0][PixW-1:0]  pix_or;
   logic [NumPe:0]            pixv_or;
+  logic [NumPe-1:0][PixW-1:0] src_pix;  // what PE i puts on the pixel chain
+  logic [NumPe-1:0]           src_pixv;
   logic [NumPe-1:0]          coll;
   logic [NumPe-1:0]          byp_d, byp_q;
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
-  assign bus_id[0]   = id_i;
-  assign bus_data[0] = data_i;
-  assign pix_or[0]   = pix_valid_i ? pix_i : '0;
-  assign pixv_or[0]  = pix_valid_i;
+  assign bus_id[0]   = link_i.id;
+  assign bus_data[0] = link_i.data;
+  assign pix_or[0]   = link_i.pix_valid ? link_i.pix : '0;
+  assign pixv_or[0]  = link_i.pix_valid;
 
   for (genvar i = 0; i < NumPe; i++) begin : g_pe
     logic [IdW-1:0]   pe_id;
@@ -152,14 +119,12 @@ module de_chip_core
     logic [DbgW-1:0]  pe_dbg;
     /* verilator lint_on UNUSEDSIGNAL */
 
-    // A bypassed PE is held in reset: its outputs are then zero, so the chain can OR
-    // them with the bypass register (below) instead of muxing with a select bit.
-    logic pe_rst;
-    assign pe_rst = rst_i || byp_q[i];
-
+    // A bypassed PE is its own bus register: it passes id and data on one clock later
+    // and holds the rest of its state in reset (de_pe bypass_i).
     de_pe #(.CarryBug(CarryBug)) u_pe (
       .clk_i,
-      .rst_i      (pe_rst),
+      .rst_i,
+      .bypass_i   (byp_q[i]),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .id_o       (pe_id),
@@ -170,74 +135,104 @@ module de_chip_core
     );
 
     // A bypassed PE is a register (registered bypass): the bus takes one clock per PE
-    // whatever the configuration, so no combinational path runs through two PEs. The
-    // bypass register holds zero while its PE is in use, and the PE's outputs are zero
-    // while it is bypassed (held in reset), so the next PE sees their OR: no select bit
-    // on the bus path. The pixel chain takes a register there too, so the pixels of the
-    // PEs in front catch up with the bus: pixels stay in raster order with no gap, one
-    // clock later per bypassed PE (docs/array.md). A faulty PE (test parameter) garbles
-    // what it passes on while it is in use.
-    logic [IdW-1:0]   byp_id_q;
-    logic [DataW-1:0] byp_data_q;
+    // whatever the configuration, so no combinational path runs through two PEs. On the
+    // bus that register is the PE's own output register (bypass_i), so the next PE's
+    // input comes straight from a flip-flop. The pixel chain takes a register here, so
+    // the pixels of the PEs in front catch up with the bus: pixels stay in raster order
+    // with no gap, one clock later per bypassed PE (docs/array.md). A faulty PE (test
+    // parameter) garbles what it passes on while it is in use.
     logic             byp_pixv_q;
     logic [PixW-1:0]  byp_pix_q;
     always_ff @(posedge clk_i) begin
       if (rst_i || !byp_q[i]) begin
-        byp_id_q   <= '0;
-        byp_data_q <= '0;
         byp_pixv_q <= 1'b0;
         byp_pix_q  <= '0;
       end else begin
-        byp_id_q   <= bus_id[i];
-        byp_data_q <= bus_data[i];
         byp_pixv_q <= pixv_or[i];
         byp_pix_q  <= pix_or[i];
       end
     end
-    assign bus_id[i+1]   = byp_id_q | pe_id;
-    assign bus_data[i+1] = byp_data_q | ((FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data);
-    // At most one PE of the whole array drives a pixel in a cycle, so OR is a mux.
-    assign pix_or[i+1]  = byp_q[i] ? byp_pix_q  : pix_or[i]  | (pe_pixv ? pe_pix : '0);
-    assign pixv_or[i+1] = byp_q[i] ? byp_pixv_q : pixv_or[i] | pe_pixv;
-    assign coll[i]      = pixv_or[i] && pe_pixv && !byp_q[i];
-    assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgPaLsb:DbgId1Lsb], pe_dbg[DbgAccc3Lsb +: DbgCtlW]};
+    assign bus_id[i+1]   = pe_id;
+    assign bus_data[i+1] = (FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data;
+    // The pixel chain at PE i (below): a bypassed PE's register replaces everything in
+    // front of it, a PE in use adds its pixel. At most one PE of the whole array drives a
+    // pixel in a cycle, so OR is a mux.
+    assign src_pix[i]  = byp_q[i] ? byp_pix_q  : (pe_pixv ? pe_pix : '0);
+    assign src_pixv[i] = byp_q[i] ? byp_pixv_q : pe_pixv;
+    assign coll[i]     = pixv_or[i] && pe_pixv && !byp_q[i];
+    // A bypassed PE's stage-1 identifier register carries the passing slots; the
+    // observation word shows zero there, as it did when the PE's id_q was in reset: from
+    // the clock after the bypass bit is set to the clock after it is cleared (byp_id0_q).
+    logic byp_id0_q;
+    always_ff @(posedge clk_i) begin
+      if (rst_i) byp_id0_q <= 1'b0;
+      else byp_id0_q <= byp_q[i];
+    end
+    assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgPaLsb:DbgActLsb],
+                                       byp_id0_q ? '0 : pe_dbg[DbgId1Lsb +: IdW],
+                                       pe_dbg[DbgAccc3Lsb +: DbgCtlW]};
+  end
+
+  // The pixel chain, pix_or[n+1] = byp_q[n] ? byp_pix_q[n] : pix_or[n] | pixel of PE n,
+  // is not built as a chain of NumPe OR gates (static timing would see them all in one
+  // path, whatever the configuration) but as an OR of its sources each gated by a
+  // registered reach bit: reach_q[n][s] = source s (0: the chip input, k+1: PE k or its
+  // bypass register) gets to position n, i.e. no PE in s..n-1 is bypassed. reach_q
+  // follows byp_q (both load from byp_d), so every cycle gives the chain's values.
+  logic [NumPe:1][NumPe:0] reach_d, reach_q;
+  always_comb begin
+    reach_d = '0;
+    for (int n = 1; n <= NumPe; n++) begin
+      reach_d[n][n] = 1'b1;  // PE n-1 itself: its pixel or its bypass register
+      for (int s = n - 1; s >= 0; s--) begin
+        reach_d[n][s] = reach_d[n][s+1] && !byp_d[s];
+      end
+    end
+  end
+  for (genvar n = 1; n <= NumPe; n++) begin : g_pix_or
+    always_comb begin
+      pix_or[n]  = reach_q[n][0] ? pix_or[0] : '0;
+      pixv_or[n] = reach_q[n][0] && pixv_or[0];
+      for (int s = 1; s <= n; s++) begin
+        pix_or[n]  = pix_or[n] | (reach_q[n][s] ? src_pix[s-1] : '0);
+        pixv_or[n] = pixv_or[n] | (reach_q[n][s] && src_pixv[s-1]);
+      end
+    end
   end
 
   // Configuration shift register: enters at PE 0, leaves after PE NumPe-1.
   // {byp_q, cfg_bit_i} shifted by one; its top bit is the one leaving (cfg_bit_o).
   logic [NumPe:0] byp_shifted;
-  assign byp_shifted = {byp_q, cfg_bit_i};
+  assign byp_shifted = {byp_q, chain_i.cfg};
   always_comb begin
     byp_d = byp_q;
-    if (cfg_mode_i) byp_d = byp_shifted[NumPe-1:0];
+    if (chain_ctl_i.cfg_mode) byp_d = byp_shifted[NumPe-1:0];
   end
-  assign cfg_bit_o = byp_shifted[NumPe];
+  assign chain_o.cfg = byp_shifted[NumPe];
   assign bypass_o  = byp_q;
 
   // Observation shift register: PE 0's word shifts out first, LSB first.
   always_comb begin
     obs_d = obs_q;
-    if (obs_load_i) obs_d = obs_load;
-    else if (obs_shift_i) obs_d = {obs_bit_i, obs_q[NumPe*ObsW-1:1]};
+    if (chain_ctl_i.obs_load) obs_d = obs_load;
+    else if (chain_ctl_i.obs_shift) obs_d = {chain_i.obs, obs_q[NumPe*ObsW-1:1]};
   end
-  assign obs_bit_o = obs_q[0];
+  assign chain_o.obs = obs_q[0];
 
   // Configuration and observation registers.
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
-      byp_q <= '0;
-      obs_q <= '0;
+      byp_q   <= '0;
+      reach_q <= '1;   // no PE bypassed
+      obs_q   <= '0;
     end else begin
-      byp_q <= byp_d;
-      obs_q <= obs_d;
+      byp_q   <= byp_d;
+      reach_q <= reach_d;
+      obs_q   <= obs_d;
     end
   end
 
-  assign id_o        = bus_id[NumPe];
-  assign data_o      = bus_data[NumPe];
-  assign pix_valid_o = pixv_or[NumPe];
-  assign pix_o       = pix_or[NumPe];
-  assign coll_o      = |coll;
+  assign link_o = {bus_id[NumPe], bus_data[NumPe], pixv_or[NumPe], pix_or[NumPe], |coll};
 
 endmodule
 
@@ -246,19 +241,12 @@ endmodule
 module de_chip_bound
   import de_pkg::*;
 (
-  input  logic             clk_i,
-  input  logic             rst_i,
-  input  logic [IdW-1:0]   id_i,
-  input  logic [DataW-1:0] data_i,
-  input  logic             pix_valid_i,
-  input  logic [PixW-1:0]  pix_i,
-  input  logic             coll_i,
-  output logic [IdW-1:0]   id_o,
-  output logic [DataW-1:0] data_o,
-  output logic             pix_valid_o,
-  output logic [PixW-1:0]  pix_o,
-  output logic             coll_o
+  input  logic  clk_i,
+  input  logic  rst_i,
+  input  link_t link_i,
+  output link_t link_o
 );
+  // One register per field, named as the trace harness binds them (sim/harness).
   logic [IdW-1:0]   id_q;
   logic [DataW-1:0] data_q;
   logic             pixv_q;
@@ -266,26 +254,11 @@ module de_chip_bound
   logic             coll_q;
 
   always_ff @(posedge clk_i) begin
-    if (rst_i) begin
-      id_q   <= '0;
-      data_q <= '0;
-      pixv_q <= 1'b0;
-      pix_q  <= '0;
-      coll_q <= 1'b0;
-    end else begin
-      id_q   <= id_i;
-      data_q <= data_i;
-      pixv_q <= pix_valid_i;
-      pix_q  <= pix_i;
-      coll_q <= coll_i;
-    end
+    if (rst_i) {id_q, data_q, pixv_q, pix_q, coll_q} <= '0;
+    else       {id_q, data_q, pixv_q, pix_q, coll_q} <= link_i;
   end
 
-  assign id_o        = id_q;
-  assign data_o      = data_q;
-  assign pix_valid_o = pixv_q;
-  assign pix_o       = pix_q;
-  assign coll_o      = coll_q;
+  assign link_o = {id_q, data_q, pixv_q, pix_q, coll_q};
 endmodule
 
 `default_nettype wire

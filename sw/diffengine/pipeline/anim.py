@@ -107,6 +107,23 @@ frame (the slots of each new line not on the longest common subsequence of its c
 with the previous frame's line, counted by yproc), as a histogram and per frame.
 
     diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim] [--model fast|numpy]
+                    [--coherent] [--tol T]
+    diffengine anim --anim A --out D --coh-sweep [--frames N] [--legs 8,32,..] [--runs 4:coh:aa,..]
+
+--coherent keeps the previous frame's colour functions where they still meet the tolerance
+(yproc anim --coherent, docs/yproc.md section 11). --coh-sweep runs the animation at
+several light speeds (frames per `wander` leg) and tolerances, with and without it, and
+plots the median changed instructions per pattern line (sweep.png, sweep.json).
+
+The Load Monitor loop (docs/yproc.md section 10): --lod-compare runs the animation four
+times (open loop, look-ahead, the loop, the loop with the check before emission) and plots
+overflowing lines and quality per frame; --lod-loop runs the loop once, with --predict the
+check before emission, with --rtl the Verilated display controller's Load Monitor read
+back frame by frame instead of yproc's model of it:
+
+    diffengine anim --anim A.anim --lod-loop --rtl [--htotal N] [--chips C] [--predict]
+                    [--compare-model]      # + the same on the model, OUT/lod_rtl.png
+    diffengine anim --plot-rtl OUT1 OUT2 ... --out DIR   # several of those in one plot
 
 Exit status 0 only if no frame differs from its full re-render.
 """
@@ -198,15 +215,135 @@ def plot_changed(h: dict, path, title: str) -> None:
     plt.close(fig)
 
 
+# ---- temporally coherent fitting: the light's speed and the tolerance (docs/yproc.md 11) -
+
+def anim_variant(anim_path, dst: Path, frames: int, leg: int | None = None) -> Path:
+    """A copy of an .anim file (its scene referenced by absolute path) with `frames` frames,
+    every ramp ending at the last frame, and (leg) every `wander` leg `leg` frames long."""
+    src = Path(anim_path).resolve()
+    out = []
+    for ln in src.read_text().splitlines():
+        tok = ln.split("#")[0].split()
+        if tok and tok[0] == "scene":
+            ln = f"scene {(src.parent / tok[1]).resolve()}"
+        elif tok and tok[0] == "frames":
+            ln = f"frames {frames}"
+        elif tok and tok[0] == "wander":
+            if leg is not None:
+                tok[3] = str(leg)
+            tok[-1] = str(frames - 1)
+            ln = " ".join(tok)
+        elif tok and tok[-4:-3] == ["from"]:
+            tok[-1] = str(frames - 1)
+            ln = " ".join(tok)
+        out.append(ln)
+    dst.write_text("\n".join(out) + "\n")
+    return dst
+
+
+def changed_summary(d: Path) -> dict:
+    """Changed instructions of one `yproc anim` run over the lines the pattern covers (more
+    than the background term in frame 0): medians of changed slots and commands per line
+    and colour over every later frame, lines with no change counted as 0; the worst
+    pixel against the exact shading (max_abs_err) over every frame; how far the exact
+    shading moves a frame (the per-frame median and 90th percentile over the pixels that
+    moved, their median over the frames)."""
+    st = json.loads((Path(d) / "anim_stats.json").read_text())
+    f0 = [lines_of_de48(Path(d) / "frame000" / f"{c}.de48") for c in "rgb"]
+    cover = np.array([[len(ln) // 6 - 1 > 3 for ln in ch] for ch in f0])          # (3, H)
+    per = st["frame"][1:]
+    cs = np.array([f["changed_slots"] for f in per])[:, cover]
+    cc = np.array([f["changed_cmds"] for f in per])[:, cover]
+    slots = np.array([[len(ln) // 6 - 1 for ln in ch] for ch in f0])[cover]
+    return {"median_slots": float(np.median(cs)), "p90_slots": float(np.percentile(cs, 90)),
+            "mean_slots": float(cs.mean()), "median_cmds": float(np.median(cc)),
+            "unchanged_share": float((cs == 0).mean()), "slots_per_line": float(slots.mean()),
+            "max_abs_err": max(f["max_abs_err"] for f in st["frame"]), "tol": st["tol"],
+            "exact_change_median": float(np.median([f["exact_change"]["median"] for f in per]))
+            if all("exact_change" in f for f in per) else None,
+            "exact_change_p90": float(np.median([f["exact_change"]["p90"] for f in per]))
+            if all("exact_change" in f for f in per) else None,
+            "frames_differing_from_full": st["frames_differing_from_full"],
+            "mean_incremental_ms": st["mean_incremental_ms"], "mean_full_ms": st["mean_full_ms"],
+            # YPD1 sends every changed line whole: its bytes against the changed slots' words
+            "delta_bytes_per_frame": float(np.mean([(Path(d) / f"frame{f['frame']:03d}.delta").stat().st_size
+                                                    for f in per])),
+            "changed_words_per_frame": float(np.mean([np.sum(f["changed_slots"]) for f in per]))}
+
+
+SWEEP_LEGS = (8, 32, 128, 512)
+SWEEP_RUNS = ((1, True, True), (4, True, True), (32, True, True), (4, True, False), (32, True, False),
+              (1, False, True), (4, False, True), (32, False, True))      # (tol, coherent, aa)
+
+
+def coherence_sweep(anim_path, out: Path, frames: int = 10, legs=SWEEP_LEGS, runs=SWEEP_RUNS) -> list[dict]:
+    """`yproc anim` of `anim_path` for every light speed (frames per `wander` leg) and run
+    (tolerance, --coherent, anti-aliasing; the plain runs at the slowest and fastest leg
+    only): changed instructions per pattern line (changed_summary). Writes sweep.json (with
+    the runs of an earlier sweep into `out` that were not repeated) and sweep.png."""
+    yproc = build_yproc()
+    res = []
+    for tol, coh, aa in runs:
+        for leg in (legs if coh else sorted({legs[0], legs[-1]})):
+            name = f"t{tol}_l{leg}_{'coh' if coh else 'plain'}{'' if aa else '_noaa'}"
+            a = anim_variant(anim_path, out / f"{name}.anim", frames, leg)
+            t0 = time.time()
+            flags = ["--tol", str(tol)] + (["--coherent"] if coh else []) + ([] if aa else ["--no-aa"])
+            r = subprocess.run([str(yproc), "anim", str(a), "-o", str(out / name), *flags],
+                               capture_output=True, text=True)
+            if r.returncode:
+                raise RuntimeError(f"yproc anim {a} {' '.join(flags)} failed:\n{r.stderr}")
+            row = {"tol": tol, "coherent": coh, "aa": aa, "leg": leg, **changed_summary(out / name)}
+            res.append(row)
+            print(f"  tol {tol:>2} {'coherent' if coh else 'plain   '} {'aa  ' if aa else 'noaa'} leg {leg:>3}: "
+                  f"median {row['median_slots']:.0f} slots / {row['median_cmds']:.0f} commands changed per "
+                  f"line, {100 * row['unchanged_share']:.0f} % of lines unchanged, worst pixel "
+                  f"{row['max_abs_err']:.2f} ({time.time() - t0:.0f} s)", flush=True)
+    # runs of an earlier sweep into the same folder stay unless re-run here
+    key = lambda r: (r["tol"], r["coherent"], r["aa"], r["leg"])
+    old = json.loads((out / "sweep.json").read_text()) if (out / "sweep.json").exists() else []
+    new = {key(r) for r in res}
+    res = sorted([r for r in old if key(r) not in new] + res, key=key)
+    (out / "sweep.json").write_text(json.dumps(res, indent=1) + "\n")
+    plot_sweep(res, out / "sweep.png", Path(anim_path).name, frames)
+    return res
+
+
+def plot_sweep(res: list[dict], path, title: str, frames: int) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
+    keys = sorted({(r["tol"], r["coherent"], r["aa"]) for r in res}, key=lambda k: (not k[1], not k[2], k[0]))
+    for k in keys:
+        rr = sorted((r for r in res if (r["tol"], r["coherent"], r["aa"]) == k), key=lambda r: r["leg"])
+        lab = f"tol {k[0]}, {'coherent' if k[1] else 'plain refit'}{'' if k[2] else ', no AA'}"
+        ls = "-" if k[1] else ":"
+        for i, key in enumerate(("median_slots", "median_cmds")):
+            ax[i].plot([r["leg"] for r in rr], [r[key] for r in rr], ls, marker="o", label=lab)
+    for i, what in enumerate(("instruction slots", "commands")):
+        ax[i].axhline(5, color="grey", lw=0.8)
+        ax[i].set_xscale("log", base=2)
+        ax[i].set_xlabel("frames per leg of the light's wander (50 Hz: /50 s)")
+        ax[i].set_ylabel(f"median changed {what} per line")
+        ax[i].set_ylim(bottom=0)
+    ax[0].legend(fontsize=7)
+    fig.suptitle(f"{title}: changed instructions per pattern line and colour, {frames} frames a run", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 # ---- the Load Monitor loop, before and after (docs/yproc.md section 10) -----------------
 
 LOD_RUNS = (("open", ("--no-degrade",), "open loop: full quality, no look-ahead"),
             ("ahead", (), "look-ahead degradation inside each line (yproc's default)"),
-            ("loop", ("--lod-loop",), "Load Monitor loop: per-line level from the previous frame"))
+            ("loop", ("--lod-loop",), "Load Monitor loop: per-line level from the previous frame"),
+            ("predict", ("--lod-predict",), "the loop + each line checked before it is emitted"))
 
 
 def lod_compare(anim_path, out: Path, extra=()) -> dict:
-    """`yproc anim` three times (LOD_RUNS): per frame the lines the Load Monitor (yproc's
+    """`yproc anim` four times (LOD_RUNS): per frame the lines the Load Monitor (yproc's
     model of it, equal to the RTL's: test_fig727_lod.py) reports late, the mean level of
     detail, and for the loop the level of every line. Writes lod.json and lod.png."""
     yproc = build_yproc()
@@ -236,6 +373,8 @@ def lod_run_stats(d: Path) -> dict:
             "mean_level": [f["mean_level"] for f in fr],
             "max_issued": [max(f["issued"]) for f in fr],
             "levels": [f["levels"] for f in fr],
+            "lowered": [f.get("lowered_before_emit", 0) for f in fr],
+            "tess": [f["tess"] for f in fr] if "tess" in fr[0] else None,
             "capacity": st["capacity"], "mean_scan_ms": st["mean_incremental_scan_ms"]}
 
 
@@ -244,8 +383,10 @@ def plot_lod(res: dict, path, title: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
-    col = {"open": "#cc6677", "ahead": "#ddaa33", "loop": "#4477aa"}
+    col = {"open": "#cc6677", "ahead": "#ddaa33", "loop": "#4477aa", "predict": "#228833"}
     for name, _, label in LOD_RUNS:
+        if name not in res:
+            continue
         r = res[name]
         ax[0].plot(r["overflow_lines"], label=label, color=col[name], marker=".")
         if name != "ahead":     # the look-ahead lowers patterns inside a line, not line levels
@@ -254,20 +395,192 @@ def plot_lod(res: dict, path, title: str) -> None:
     ax[0].set_ylabel("late (overflowing) lines")
     ax[0].set_title("overflowing lines per frame")
     ax[0].legend(fontsize=7)
+    tess = res.get("predict", {}).get("tess")
+    if tess:
+        # tessellation (yp_tess.c): the mesh version each object shows, 0 = its own mesh
+        tw = ax[1].twinx()
+        for k in range(len(tess[0])):
+            tw.step(range(len(tess)), [t[k] for t in tess], where="mid", color="#aa3377", ls="--",
+                    label=f"object {k}: mesh version shown (0 = finest)")
+        tw.set_ylabel("mesh version (predict run)", color="#aa3377")
+        tw.set_ylim(-0.2, max(max(t) for t in tess) + 1.5)
+        tw.legend(fontsize=7, loc="upper right")
     ax[1].set_xlabel("frame")
     ax[1].set_ylabel("mean level of detail (5 = full)")
     ax[1].set_title("quality per frame")
     ax[1].set_ylim(0, 5.3)
-    lv = np.array(res["loop"]["levels"]).T
+    last = "predict" if "predict" in res else "loop"
+    lv = np.array(res[last]["levels"]).T
     im = ax[2].imshow(lv, aspect="auto", cmap="viridis", vmin=0, vmax=5, interpolation="nearest")
     ax[2].set_xlabel("frame")
     ax[2].set_ylabel("scanline")
-    ax[2].set_title("the loop's level per line")
+    ax[2].set_title(f"level per line ({last})")
     fig.colorbar(im, ax=ax[2], fraction=0.05)
     fig.suptitle(f"{title}: capacity {res['loop']['capacity']} slots per line and colour", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def monitor_record(stats: dict, height: int) -> tuple[list[int], list[int]]:
+    """The Load Monitor's line table of one harness run (one frame played): per line the
+    largest `issued` of the three colours and 1 if any colour was late, as the loop reads
+    it (yp_lod_update)."""
+    lm = stats["load_monitor"]
+    issued = np.max([lm[c]["line_issued"][:height] for c in "RGB"], axis=0)
+    late = np.zeros(height, int)
+    for c in "RGB":
+        for y in lm[c]["late_line_numbers"]:
+            if y < height:
+                late[y] = 1
+    return [int(v) for v in issued], [int(v) for v in late]
+
+
+def anim_screen(anim_path) -> tuple[int, int]:
+    """(width, height) of an animation: its scene file's `screen` statement (640x480
+    without one)."""
+    anim_path = Path(anim_path)
+    for ln in anim_path.read_text().splitlines():
+        t = ln.split("#")[0].split()
+        if len(t) == 2 and t[0] == "scene":
+            sc = Path(t[1]) if Path(t[1]).is_absolute() else anim_path.parent / t[1]
+            for sl in sc.read_text().splitlines():
+                u = sl.split("#")[0].split()
+                if len(u) == 3 and u[0] == "screen":
+                    return int(u[1]), int(u[2])
+            return 640, 480
+    raise ValueError(f"{anim_path}: no 'scene FILE'")
+
+
+def lod_loop(anim_path, out: Path, predict: bool = False, rtl: bool = False, chips: int | None = None,
+             test: tuple | None = None, capacity: int | None = None, extra=(), log=print) -> dict:
+    """`yproc anim --lod-loop` (`--lod-predict` with predict) once; `capacity`: yproc's
+    --capacity (default: the video mode's). With rtl, the loop reads the Verilated display
+    controller instead of yproc's model of its Load Monitor: yproc runs with
+    --monitor-stdin, and after each frame (frame 0's streams, then each delta applied) the
+    frame is played through the controller (diffengine.rtl.dc_harness, one harness run per
+    frame) and its Load Monitor's line table (monitor_record) goes back to yproc on stdin,
+    which takes the next frame's levels from it. `test`: the controller's geometry (default
+    demo.controller_setup's for the animation's screen, HTotal 800); the capacity is then
+    the controller's (demo.capacity: HTotal - 2) unless given. `chips`: per colour (default
+    the fewest that cover the width). Returns anim_stats.json, with rtl also "rtl_seconds"
+    and "frames_played"."""
+    from .demo import capacity as ctrl_capacity, controller_setup
+    yproc = build_yproc()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    flags = ["--lod-predict" if predict else "--lod-loop", *map(str, extra)]
+    if rtl:
+        W, H = anim_screen(anim_path)
+        chips = chips or max(1, -(-W // 9))
+        mode, geom = controller_setup(W, H, chips)
+        if test is not None:
+            mode, geom = 3, tuple(test)
+        if capacity is None:
+            capacity = ctrl_capacity(mode, geom)
+    if capacity is not None:
+        flags += ["--capacity", str(capacity)]
+    if not rtl:
+        r = subprocess.run([str(yproc), "anim", str(anim_path), "-o", str(out), *flags],
+                           capture_output=True, text=True)
+        if r.returncode:
+            raise RuntimeError(f"yproc anim {' '.join(flags)} failed:\n{r.stderr}")
+        return json.loads((out / "anim_stats.json").read_text())
+    from ..rtl import dc_harness
+    cfg = dc_harness.Config(chips=chips, test=geom)
+    errpath = out / "yproc_stderr.txt"
+    with open(errpath, "w") as err:
+        proc = subprocess.Popen([str(yproc), "anim", str(anim_path), "-o", str(out), *flags, "--monitor-stdin"],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True)
+        cur, played, t_rtl = None, 0, 0.0
+        try:
+            for line in proc.stdout:
+                if not line.startswith("monitor "):
+                    continue
+                f = int(line.split()[1])
+                if f == 0:
+                    cur = [lines_of_de48(out / "frame000" / f"{c}.de48") for c in "rgb"]
+                else:
+                    _, _, _, chans = read_delta(out / f"frame{f:03d}.delta")
+                    for c in range(3):
+                        for y, words in chans[c].items():
+                            cur[c][y] = words
+                t0 = time.time()
+                paths = []
+                for c, name in enumerate("rgb"):
+                    paths.append(out / f"rtl_{name}.de48")
+                    paths[-1].write_bytes(to_de48(cur[c]))
+                _, st = dc_harness.run(paths, cfg, mode=mode)
+                t_rtl += time.time() - t0
+                iss, late = monitor_record(st, len(cur[0]))
+                proc.stdin.write(f"{f} " + " ".join(map(str, iss)) + " " + " ".join(map(str, late)) + "\n")
+                proc.stdin.flush()
+                played += 1
+                log(f"  frame {f}: the controller's Load Monitor: {sum(late)} late line(s), busiest "
+                    f"line {max(iss)} slots ({time.time() - t0:.1f} s)")
+            proc.wait()
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    if proc.returncode:
+        raise RuntimeError(f"yproc anim {' '.join(flags)} --monitor-stdin failed:\n" + errpath.read_text())
+    st = json.loads((out / "anim_stats.json").read_text())
+    st["rtl_seconds"], st["frames_played"] = t_rtl, played
+    return st
+
+
+def plot_lod_rtl(outs: list, path) -> dict:
+    """The Verilated controller in the loop against yproc's model (`--lod-loop --rtl
+    --compare-model` writes OUT/loop and OUT/loop_model): per OUT, late lines and mean level
+    per frame of both runs, the lines whose level differs between them, and the mesh version
+    where the animation has tessellation. Returns a summary per OUT (also lod_rtl.json)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
+    cols = ["#4477aa", "#228833", "#cc6677", "#ddaa33"]
+    summary = {}
+    for i, o in enumerate(map(Path, outs)):
+        A = json.loads((o / "loop" / "anim_stats.json").read_text())
+        B = json.loads((o / "loop_model" / "anim_stats.json").read_text())
+        col, name = cols[i % len(cols)], f"{Path(A['anim']).name}{' + check' if A.get('lod_predict') else ''}"
+        diff = [sum(a != b for a, b in zip(x["levels"], y["levels"])) for x, y in zip(A["frame"], B["frame"])]
+        summary[str(o)] = {"anim": A["anim"], "predict": A.get("lod_predict", 0),
+                           "late_lines": sum(f["overflow_lines"] for f in A["frame"]),
+                           "frames_model_agrees": sum(f.get("model_agrees", 0) for f in A["frame"]),
+                           "frames": len(A["frame"]), "level_differences": sum(diff),
+                           "tess_same": [f.get("tess") for f in A["frame"]] == [f.get("tess") for f in B["frame"]]}
+        ax[0].plot([f["overflow_lines"] for f in A["frame"]], color=col, marker=".", label=f"{name}: RTL")
+        ax[0].plot([f["overflow_lines"] for f in B["frame"]], color=col, ls=":", lw=3, alpha=.6,
+                   label=f"{name}: model")
+        ax[1].plot([f["mean_level"] for f in A["frame"]], color=col, marker=".")
+        ax[1].plot([f["mean_level"] for f in B["frame"]], color=col, ls=":", lw=3, alpha=.6)
+        ax[2].plot(diff, color=col, marker=".", label=name)
+        if "tess" in A["frame"][0]:
+            tw = ax[1].twinx()
+            tw.step(range(len(A["frame"])), [f["tess"][0] for f in A["frame"]], where="mid", color="#aa3377",
+                    ls="--", label=f"{name}: mesh version (RTL run)")
+            tw.set_ylim(-0.2, 3)
+            tw.set_ylabel("mesh version", color="#aa3377")
+            tw.legend(fontsize=7, loc="upper right")
+    ax[0].set_title("late lines per frame (the controller's record)")
+    ax[0].set_xlabel("frame")
+    ax[0].legend(fontsize=6, loc="upper right")
+    ax[1].set_title("mean level per frame")
+    ax[1].set_xlabel("frame")
+    ax[1].set_ylim(0, 5.3)
+    ax[2].set_title("lines whose level differs, RTL against model")
+    ax[2].set_xlabel("frame")
+    ax[2].set_ylim(-0.5, 5)
+    ax[2].legend(fontsize=7)
+    fig.suptitle("The Verilated display controller's Load Monitor read back every frame "
+                 "(dotted: the same animation on yproc's model)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    Path(path).with_suffix(".json").write_text(json.dumps(summary, indent=1) + "\n")
+    return summary
 
 
 def configure(ap) -> None:
@@ -279,19 +592,90 @@ def configure(ap) -> None:
                     help="golden model of the changed lines: fast = the C functional model "
                          "(default), numpy = diffengine.model.functional")
     ap.add_argument("--lod-compare", action="store_true",
-                    help="instead: the animation three times (open loop, look-ahead degradation, "
-                         "Load Monitor loop): overflowing lines and quality per frame -> OUT/lod.png, "
+                    help="instead: the animation four times (open loop, look-ahead degradation, "
+                         "Load Monitor loop, the loop with the check before emission): overflowing lines and quality per frame -> OUT/lod.png, "
                          "lod.json (docs/yproc.md section 10)")
     ap.add_argument("--mode", choices=("640x480", "640x485", "1280x1024"),
                     help="with --lod-compare: the video mode (raster and slots per line) for yproc")
+    ap.add_argument("--lod-loop", action="store_true",
+                    help="instead: the Load Monitor loop once (yproc anim --lod-loop) -> OUT/loop")
+    ap.add_argument("--predict", action="store_true",
+                    help="with --lod-loop: each line also checked against the capacity before it "
+                         "is emitted (--lod-predict)")
+    ap.add_argument("--rtl", action="store_true",
+                    help="with --lod-loop: the per-line counts come from the Verilated display "
+                         "controller's Load Monitor, frame by frame, instead of yproc's model "
+                         "(test-mode geometry, HTotal 800 unless 640x480; slow at full size)")
+    ap.add_argument("--chips", type=int, help="with --rtl: chips per colour (default: the fewest "
+                    "that cover the width)")
+    ap.add_argument("--compare-model", action="store_true",
+                    help="with --lod-loop --rtl: also the same run on yproc's model (OUT/loop_model) "
+                         "and the comparison OUT/lod_rtl.png, lod_rtl.json")
+    ap.add_argument("--plot-rtl", nargs="+", metavar="OUT",
+                    help="instead: one plot of several --lod-loop --rtl --compare-model outputs -> "
+                         "--out/lod_rtl.png")
+    ap.add_argument("--htotal", type=int, help="with --rtl: the controller's HTotal in test mode, "
+                    "porches 4 + 8 (slots per line + 2; default 800, or the 640x480 mode)")
+    ap.add_argument("--capacity", type=int, help="with --lod-loop: yproc's slots per line "
+                    "(default: the mode's, or with --rtl the controller's HTotal - 2)")
+    ap.add_argument("--coherent", action="store_true",
+                    help="yproc anim --coherent: keep the previous frame's colour functions where they "
+                         "still meet the tolerance (docs/yproc.md section 11)")
+    ap.add_argument("--tol", type=float, help="yproc's fit tolerance (pixel units; default 1)")
+    ap.add_argument("--coh-sweep", action="store_true",
+                    help="instead: the animation at several light speeds and tolerances, with and "
+                         "without --coherent: changed instructions per line -> OUT/sweep.png, sweep.json")
+    ap.add_argument("--frames", type=int, default=10, help="with --coh-sweep: frames per run (default 10)")
+    ap.add_argument("--legs", help="with --coh-sweep: frames per leg of the light, comma-separated "
+                                   f"(default {','.join(map(str, SWEEP_LEGS))})")
+    ap.add_argument("--runs", help="with --coh-sweep: the runs as TOL:coh|plain:aa|noaa, comma-separated "
+                                   "(default: every one of SWEEP_RUNS)")
     ap.set_defaults(func=command)
 
 
 def command(a) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.plot_rtl:
+        summary = plot_lod_rtl(a.plot_rtl, out / "lod_rtl.png")
+        for k, v in summary.items():
+            print(f"  {k}: {v}")
+        print(f"wrote {out / 'lod_rtl.png'}")
+        return 0
+    if a.lod_loop:
+        print(f"anim: {a.anim}: the Load Monitor loop{' + check before emission' if a.predict else ''}"
+              f"{', the Verilated controller in the loop' if a.rtl else ''}", flush=True)
+        try:
+            test = None
+            if a.htotal:
+                # short porches (front 4, sync 8) as in the tests' short lines
+                W, H = anim_screen(a.anim)
+                test = (W, 4, 8, a.htotal - W - 12, H, 1, 2, 2)
+                if test[3] < 1:
+                    raise ValueError(f"--htotal {a.htotal} leaves no back porch for width {W}")
+            st = lod_loop(a.anim, out / "loop", predict=a.predict, rtl=a.rtl, chips=a.chips, test=test,
+                          capacity=a.capacity, extra=("--mode", a.mode) if a.mode else ())
+        except (RuntimeError, ValueError) as e:
+            print(f"anim: error: {e}", file=sys.stderr)
+            return 1
+        ov = [f["overflow_lines"] for f in st["frame"]]
+        agree = [f.get("model_agrees", 1) for f in st["frame"]]
+        print(f"  late lines per frame {ov} (total {sum(ov)}); mean level per frame "
+              f"{[round(f['mean_level'], 2) for f in st['frame']]}")
+        if a.rtl:
+            print(f"  the controller's record equals yproc's model in {sum(agree)} of {len(agree)} "
+                  f"frames; RTL {st['rtl_seconds']:.0f} s for {st['frames_played']} frames")
+        if a.rtl and a.compare_model:
+            lod_loop(a.anim, out / "loop_model", predict=a.predict, capacity=st["capacity"],
+                     extra=("--mode", a.mode) if a.mode else ())
+            summary = plot_lod_rtl([out], out / "lod_rtl.png")[str(out)]
+            print(f"  the same on yproc's model: lines whose level differs {summary['level_differences']}, "
+                  f"mesh versions the same: {summary['tess_same']} ({out / 'lod_rtl.png'})")
+            agree.append(summary["level_differences"] == 0 and summary["tess_same"])
+        print(f"wrote {out / 'loop'}")
+        return 0 if st["frames_differing_from_full"] == 0 and all(agree) else 1
     if a.lod_compare:
-        print(f"anim: {a.anim} three times (open loop, look-ahead, Load Monitor loop)", flush=True)
+        print(f"anim: {a.anim} four times (open loop, look-ahead, Load Monitor loop, loop + check)", flush=True)
         try:
             lod_compare(a.anim, out, ("--mode", a.mode) if a.mode else ())
         except RuntimeError as e:
@@ -299,10 +683,32 @@ def command(a) -> int:
             return 1
         print(f"wrote {out / 'lod.png'}, {out / 'lod.json'}")
         return 0
+    if a.coh_sweep:
+        print(f"anim: {a.anim} at light speeds {a.legs or SWEEP_LEGS} frames per leg, {a.frames} frames a run",
+              flush=True)
+        try:
+            legs = tuple(int(v) for v in a.legs.split(",")) if a.legs else SWEEP_LEGS
+            runs = SWEEP_RUNS
+            if a.runs:
+                runs = []
+                for r in a.runs.split(","):
+                    t, c, aa = r.split(":")
+                    if c not in ("coh", "plain") or aa not in ("aa", "noaa"):
+                        print(f"anim: --runs: '{r}' is not TOL:coh|plain:aa|noaa", file=sys.stderr)
+                        return 2
+                    runs.append((float(t) if "." in t else int(t), c == "coh", aa == "aa"))
+            coherence_sweep(a.anim, out, a.frames, legs, runs)
+        except RuntimeError as e:
+            print(f"anim: error: {e}", file=sys.stderr)
+            return 1
+        print(f"wrote {out / 'sweep.png'}, {out / 'sweep.json'}")
+        return 0
     yproc = build_yproc()
     t0 = time.time()
-    print(f"anim: yproc anim {a.anim} (each frame also re-rendered in full for the check)", flush=True)
-    res = subprocess.run([str(yproc), "anim", a.anim, "-o", str(out / "streams")],
+    flags = (["--coherent"] if a.coherent else []) + (["--tol", str(a.tol)] if a.tol else [])
+    print(f"anim: yproc anim {a.anim} {' '.join(flags)} (each frame also re-rendered in full for the check)",
+          flush=True)
+    res = subprocess.run([str(yproc), "anim", a.anim, "-o", str(out / "streams"), *flags],
                          capture_output=True, text=True)
     if res.returncode:
         print(f"anim: error: yproc anim failed:\n{res.stderr}", file=sys.stderr)

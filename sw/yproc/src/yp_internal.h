@@ -56,6 +56,12 @@ typedef struct yp_animx yp_animx;
 int yp_animx_parse(yp_animx **x, const hsr_scene *sc, char **tok, int nt, char *msg, size_t msglen);
 int yp_animx_apply(yp_animx *x, int f, yp_shader *sh, hsr_status *st);
 void yp_animx_free(yp_animx *x);
+/* yp_tess.c: the `tessellation` statement (1 taken, 0 not ours, -1 error in msg; appends
+ * the clustered versions to sc), the offsets of the versions (each follows its object's
+ * move in off[3 * obj], the hidden ones parked behind the eye), and free */
+int yp_tess_parse(yp_tess **t, hsr_scene *sc, char **tok, int nt, char *msg, size_t msglen);
+void yp_tess_offsets(const yp_tess *t, const hsr_scene *sc, double *off);
+void yp_tess_free(yp_tess *t);
 
 /* yp_cover.c: signed-area accumulation of a closed ring set (pixel
  * coordinates relative to the buffer origin) into acc (ny rows of
@@ -69,6 +75,19 @@ void yp_cover_ring(const double *xy, int n, double *acc, int nx, int ny);
  * starting at column x0 to out (Sets first); returns knots or -1. */
 int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order,
            double tol, int clamp, yp_cmdlist *out);   /* tolv: per-pixel tolerance or NULL */
+/* yp_fit, temporally coherent (docs/yproc.md section 11): prev's commands i0..i1-1 (the
+ * previous frame's line) are searched for an Eval of the same order at x0; where its
+ * spline (with the Sets before it) still meets the tolerance against f its Sets are
+ * kept word for word, and only the failing pixels are refitted, rejoining the old
+ * spline with SetI / SetdI / Set of the top difference.  Falls back to yp_fit (no
+ * candidate, or a result more than a quarter above yp_fit's slots).  hyst (0 < hyst
+ * <= 1): what is fitted anew is fitted at hyst * tol (and hyst * tolv), so that it can
+ * stay while the target drifts by up to (1 - hyst) * tol; prev NULL: yp_fit at hyst *
+ * tol.  *kept: 1 if the old spline was used.  Same error bound as yp_fit at tol (the
+ * result is re-checked). */
+int yp_fit_coherent(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order,
+                    double tol, int clamp, double hyst, const yp_cmdlist *prev, int i0, int i1, yp_cmdlist *out,
+                    int *kept);
 /* forward differencing of an order-p Eval with knots (value per column) */
 void yp_eval_values(int order, const int64_t *v0, int n, const int *knot_pos,
                     const int64_t *knot_c, int nk, int64_t *val);
