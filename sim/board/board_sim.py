@@ -21,10 +21,12 @@ late-line and dropped-word totals and the SDRAM model's violation count.
 Checks per case: every frame after the sequence starts equals its golden frame exactly,
 in the sequence's order (an animation: frames 0, 1, 2, switching at frame boundaries;
 --loops > 0 also shows the wrap back to frame 0), 0 late lines, 0 dropped words,
-0 SDRAM violations, sync and loader replies right. Writes per case OUT/CASE/: the
-decoded frames as PNG (frame_NN.png), golden_NN.png, diff_NN.png (differing pixels red
-on the dimmed golden), stats.json (the harness's), and OUT/summary.json and
-OUT/summary.md. Exit status 0 only if every case passed.
+0 SDRAM violations, sync and loader replies right; the span arrays' FIFO overflow and
+late flags are reported as warnings. Writes per case OUT/CASE/: the decoded frames as
+PNG (frame_NN.png), golden_NN.png, diff_NN.png (differing pixels red, each in a red
+9x9 box, on the dimmed golden), strip.png (an animation's frames side by side),
+stats.json (the harness's); OUT/summary.json and OUT/summary.md. Exit status 0 only if
+every case passed.
 """
 from __future__ import annotations
 
@@ -179,8 +181,15 @@ def run_case(case: str, a, exe: Path) -> dict:
         g = gold[expect[k]]
         bad = np.any(img != g, axis=-1)
         diff = (g // 3).astype(np.uint8)
-        diff[bad] = (255, 0, 0)
+        # A few wrong pixels must show at a glance: a red 9x9 box around each.
+        near = np.zeros_like(bad)
+        for y, x in np.argwhere(bad):
+            near[max(0, y - 4):y + 5, max(0, x - 4):x + 5] = True
+        diff[near] = (160, 0, 0)
+        diff[bad] = (255, 64, 64)
         frame.write_rgb8(out / f"diff_{k:02d}.png", diff)
+    if len(frames) > 1 and len(dec) >= len(frames):   # the sequence once, side by side
+        frame.write_rgb8(out / "strip.png", np.concatenate(list(dec[:len(frames)]), axis=1))
     summary = {
         "case": case, "ok": not errors and res["ok"], "errors": errors,
         "frames_packed": len(frames), "sequence": list(plan.sequence),
@@ -193,32 +202,43 @@ def run_case(case: str, a, exe: Path) -> dict:
         "seconds": round(wall, 1), "cpu_seconds": res["cpu_seconds"],
         "pixel_clocks_per_second": res["pixel_clocks_per_second"],
         "black_frames_before": res["first_live_frame"], "status": res["status"],
+        "warnings": res["warnings"],
+        "span_overflow_first": [sa["overflow_first"] for sa in res["span_arrays"]],
     }
     log(f"{case}: {'PASS' if summary['ok'] else 'FAIL'}: frames {order} (want {expect}), "
         f"pixels differing {summary['pixels_differing']}, late lines {res['late_lines']}, "
         f"dropped words {res['dropped_words']}, SDRAM violations {res['sdram']['violations']}; "
         f"{res['simulated_ms']:.1f} ms simulated in {wall:.0f} s"
-        + ("".join(f"\n  error: {e}" for e in errors)))
+        + "".join(f"\n  warning: {w}" for w in res["warnings"])
+        + "".join(f"\n  error: {e}" for e in errors))
     return summary
 
 
 def write_summary(results: list[dict], out: Path, a) -> None:
     (out / "summary.json").write_text(json.dumps(results, indent=1) + "\n")
     rows = ["| case | frames (shown / want) | pixels differing | late lines | dropped words "
-            "| SDRAM violations | simulated | wall (CPU) | result |",
-            "|---|---|---|---|---|---|---|---|---|"]
+            "| SDRAM violations | span FIFO overflow (first: frame, line) | simulated "
+            "| wall (CPU) | result |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         if "frames_shown" not in r:
-            rows.append(f"| {r['case']} | - | - | - | - | - | - | - | FAIL: {r['errors']} |")
+            rows.append(f"| {r['case']} | - | - | - | - | - | - | - | - | FAIL: {r['errors']} |")
             continue
-        rows.append(f"| {r['case']} | {r['frames_shown']} / {r['frames_expected']} | "
+        ovf = sorted({(o[1] - r["black_frames_before"], o[2]) for o in r["span_overflow_first"]
+                      if o[0] >= 0})
+        ovf_s = ", ".join(f"sequence frame {f}, line {y}" for f, y in ovf) or "none"
+        shown = ", ".join("≠" if k < 0 else str(k) for k in r["frames_shown"])
+        want = ", ".join(str(k) for k in r["frames_expected"])
+        rows.append(f"| {r['case']} | {shown} / {want} | "
                     f"{r['pixels_differing']} | {r['late_lines']} | {r['dropped_words']} | "
-                    f"{r['sdram_violations']} | {r['simulated_ms']:.1f} ms | "
+                    f"{r['sdram_violations']} | {ovf_s} | {r['simulated_ms']:.1f} ms | "
                     f"{r['seconds']:.0f} s ({r['cpu_seconds']:.0f} s) | "
                     f"{'PASS' if r['ok'] else 'FAIL'} |")
     (out / "summary.md").write_text(
         f"# Whole-board full-frame simulations\n\n`{' '.join(sys.argv)}`, "
-        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}\n\n" + "\n".join(rows) + "\n")
+        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}\n\n" + "\n".join(rows)
+        + "\n\nFrames shown: the golden frame each decoded frame equals exactly, from the first "
+        "that is not black (≠: none).\n")
 
 
 def main(argv=None) -> int:
