@@ -48,7 +48,8 @@ help:
 	@echo "make sim-board   whole-board full-frame simulations: teapot and CAD frames and 3 animation"
 	@echo "                 frames from the SDRAM model through the TMDS encoders, bit-exact vs the"
 	@echo "                 golden model, late lines, SDRAM violations -> out/board_sim (docs/board-frames.md;"
-	@echo "                 CASES=teapot,cad,anim THREADS=1; builds the 72-chip board first, long)"
+	@echo "                 CASES=teapot,cad,anim LOOPS=1 THREADS=1; builds the 72-chip board first:"
+	@echo "                 ~2 min, then ~1-1.5 min per case on 2 loaded cores)"
 	@echo "make postsynth   yosys netlists simulated in Icarus against the golden model"
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
 	@echo "make setup       create .venv from scripts/requirements.txt"
@@ -184,8 +185,10 @@ fpga-board: $(SETUP)
 
 # The whole-board full-frame simulations (docs/board-frames.md): sim/board/board_sim.py.
 CASES ?= teapot,cad,anim
+LOOPS ?= 1
 sim-board: $(SETUP)
-	$(ENV) $(PY) sim/board/board_sim.py --cases $(CASES) --threads $(THREADS) --out $(OUT)/board_sim
+	$(ENV) $(PY) sim/board/board_sim.py --cases $(CASES) --loops $(LOOPS) --threads $(THREADS) \
+	  --out $(OUT)/board_sim
 
 postsynth: $(SETUP)
 	$(MAKE) -C fpga postsynth
