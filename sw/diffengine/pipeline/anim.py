@@ -108,6 +108,16 @@ with the previous frame's line, counted by yproc), as a histogram and per frame.
 
     diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim] [--model fast|numpy]
 
+The Load Monitor loop (docs/yproc.md section 10): --lod-compare runs the animation four
+times (open loop, look-ahead, the loop, the loop with the check before emission) and plots
+overflowing lines and quality per frame; --lod-loop runs the loop once, with --predict the
+check before emission, with --rtl the Verilated display controller's Load Monitor read
+back frame by frame instead of yproc's model of it:
+
+    diffengine anim --anim A.anim --lod-loop --rtl [--htotal N] [--chips C] [--predict]
+                    [--compare-model]      # + the same on the model, OUT/lod_rtl.png
+    diffengine anim --plot-rtl OUT1 OUT2 ... --out DIR   # several of those in one plot
+
 Exit status 0 only if no frame differs from its full re-render.
 """
 
@@ -202,11 +212,12 @@ def plot_changed(h: dict, path, title: str) -> None:
 
 LOD_RUNS = (("open", ("--no-degrade",), "open loop: full quality, no look-ahead"),
             ("ahead", (), "look-ahead degradation inside each line (yproc's default)"),
-            ("loop", ("--lod-loop",), "Load Monitor loop: per-line level from the previous frame"))
+            ("loop", ("--lod-loop",), "Load Monitor loop: per-line level from the previous frame"),
+            ("predict", ("--lod-predict",), "the loop + each line checked before it is emitted"))
 
 
 def lod_compare(anim_path, out: Path, extra=()) -> dict:
-    """`yproc anim` three times (LOD_RUNS): per frame the lines the Load Monitor (yproc's
+    """`yproc anim` four times (LOD_RUNS): per frame the lines the Load Monitor (yproc's
     model of it, equal to the RTL's: test_fig727_lod.py) reports late, the mean level of
     detail, and for the loop the level of every line. Writes lod.json and lod.png."""
     yproc = build_yproc()
@@ -236,6 +247,8 @@ def lod_run_stats(d: Path) -> dict:
             "mean_level": [f["mean_level"] for f in fr],
             "max_issued": [max(f["issued"]) for f in fr],
             "levels": [f["levels"] for f in fr],
+            "lowered": [f.get("lowered_before_emit", 0) for f in fr],
+            "tess": [f["tess"] for f in fr] if "tess" in fr[0] else None,
             "capacity": st["capacity"], "mean_scan_ms": st["mean_incremental_scan_ms"]}
 
 
@@ -244,8 +257,10 @@ def plot_lod(res: dict, path, title: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
-    col = {"open": "#cc6677", "ahead": "#ddaa33", "loop": "#4477aa"}
+    col = {"open": "#cc6677", "ahead": "#ddaa33", "loop": "#4477aa", "predict": "#228833"}
     for name, _, label in LOD_RUNS:
+        if name not in res:
+            continue
         r = res[name]
         ax[0].plot(r["overflow_lines"], label=label, color=col[name], marker=".")
         if name != "ahead":     # the look-ahead lowers patterns inside a line, not line levels
@@ -254,20 +269,192 @@ def plot_lod(res: dict, path, title: str) -> None:
     ax[0].set_ylabel("late (overflowing) lines")
     ax[0].set_title("overflowing lines per frame")
     ax[0].legend(fontsize=7)
+    tess = res.get("predict", {}).get("tess")
+    if tess:
+        # tessellation (yp_tess.c): the mesh version each object shows, 0 = its own mesh
+        tw = ax[1].twinx()
+        for k in range(len(tess[0])):
+            tw.step(range(len(tess)), [t[k] for t in tess], where="mid", color="#aa3377", ls="--",
+                    label=f"object {k}: mesh version shown (0 = finest)")
+        tw.set_ylabel("mesh version (predict run)", color="#aa3377")
+        tw.set_ylim(-0.2, max(max(t) for t in tess) + 1.5)
+        tw.legend(fontsize=7, loc="upper right")
     ax[1].set_xlabel("frame")
     ax[1].set_ylabel("mean level of detail (5 = full)")
     ax[1].set_title("quality per frame")
     ax[1].set_ylim(0, 5.3)
-    lv = np.array(res["loop"]["levels"]).T
+    last = "predict" if "predict" in res else "loop"
+    lv = np.array(res[last]["levels"]).T
     im = ax[2].imshow(lv, aspect="auto", cmap="viridis", vmin=0, vmax=5, interpolation="nearest")
     ax[2].set_xlabel("frame")
     ax[2].set_ylabel("scanline")
-    ax[2].set_title("the loop's level per line")
+    ax[2].set_title(f"level per line ({last})")
     fig.colorbar(im, ax=ax[2], fraction=0.05)
     fig.suptitle(f"{title}: capacity {res['loop']['capacity']} slots per line and colour", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def monitor_record(stats: dict, height: int) -> tuple[list[int], list[int]]:
+    """The Load Monitor's line table of one harness run (one frame played): per line the
+    largest `issued` of the three colours and 1 if any colour was late, as the loop reads
+    it (yp_lod_update)."""
+    lm = stats["load_monitor"]
+    issued = np.max([lm[c]["line_issued"][:height] for c in "RGB"], axis=0)
+    late = np.zeros(height, int)
+    for c in "RGB":
+        for y in lm[c]["late_line_numbers"]:
+            if y < height:
+                late[y] = 1
+    return [int(v) for v in issued], [int(v) for v in late]
+
+
+def anim_screen(anim_path) -> tuple[int, int]:
+    """(width, height) of an animation: its scene file's `screen` statement (640x480
+    without one)."""
+    anim_path = Path(anim_path)
+    for ln in anim_path.read_text().splitlines():
+        t = ln.split("#")[0].split()
+        if len(t) == 2 and t[0] == "scene":
+            sc = Path(t[1]) if Path(t[1]).is_absolute() else anim_path.parent / t[1]
+            for sl in sc.read_text().splitlines():
+                u = sl.split("#")[0].split()
+                if len(u) == 3 and u[0] == "screen":
+                    return int(u[1]), int(u[2])
+            return 640, 480
+    raise ValueError(f"{anim_path}: no 'scene FILE'")
+
+
+def lod_loop(anim_path, out: Path, predict: bool = False, rtl: bool = False, chips: int | None = None,
+             test: tuple | None = None, capacity: int | None = None, extra=(), log=print) -> dict:
+    """`yproc anim --lod-loop` (`--lod-predict` with predict) once; `capacity`: yproc's
+    --capacity (default: the video mode's). With rtl, the loop reads the Verilated display
+    controller instead of yproc's model of its Load Monitor: yproc runs with
+    --monitor-stdin, and after each frame (frame 0's streams, then each delta applied) the
+    frame is played through the controller (diffengine.rtl.dc_harness, one harness run per
+    frame) and its Load Monitor's line table (monitor_record) goes back to yproc on stdin,
+    which takes the next frame's levels from it. `test`: the controller's geometry (default
+    demo.controller_setup's for the animation's screen, HTotal 800); the capacity is then
+    the controller's (demo.capacity: HTotal - 2) unless given. `chips`: per colour (default
+    the fewest that cover the width). Returns anim_stats.json, with rtl also "rtl_seconds"
+    and "frames_played"."""
+    from .demo import capacity as ctrl_capacity, controller_setup
+    yproc = build_yproc()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    flags = ["--lod-predict" if predict else "--lod-loop", *map(str, extra)]
+    if rtl:
+        W, H = anim_screen(anim_path)
+        chips = chips or max(1, -(-W // 9))
+        mode, geom = controller_setup(W, H, chips)
+        if test is not None:
+            mode, geom = 3, tuple(test)
+        if capacity is None:
+            capacity = ctrl_capacity(mode, geom)
+    if capacity is not None:
+        flags += ["--capacity", str(capacity)]
+    if not rtl:
+        r = subprocess.run([str(yproc), "anim", str(anim_path), "-o", str(out), *flags],
+                           capture_output=True, text=True)
+        if r.returncode:
+            raise RuntimeError(f"yproc anim {' '.join(flags)} failed:\n{r.stderr}")
+        return json.loads((out / "anim_stats.json").read_text())
+    from ..rtl import dc_harness
+    cfg = dc_harness.Config(chips=chips, test=geom)
+    errpath = out / "yproc_stderr.txt"
+    with open(errpath, "w") as err:
+        proc = subprocess.Popen([str(yproc), "anim", str(anim_path), "-o", str(out), *flags, "--monitor-stdin"],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True)
+        cur, played, t_rtl = None, 0, 0.0
+        try:
+            for line in proc.stdout:
+                if not line.startswith("monitor "):
+                    continue
+                f = int(line.split()[1])
+                if f == 0:
+                    cur = [lines_of_de48(out / "frame000" / f"{c}.de48") for c in "rgb"]
+                else:
+                    _, _, _, chans = read_delta(out / f"frame{f:03d}.delta")
+                    for c in range(3):
+                        for y, words in chans[c].items():
+                            cur[c][y] = words
+                t0 = time.time()
+                paths = []
+                for c, name in enumerate("rgb"):
+                    paths.append(out / f"rtl_{name}.de48")
+                    paths[-1].write_bytes(to_de48(cur[c]))
+                _, st = dc_harness.run(paths, cfg, mode=mode)
+                t_rtl += time.time() - t0
+                iss, late = monitor_record(st, len(cur[0]))
+                proc.stdin.write(f"{f} " + " ".join(map(str, iss)) + " " + " ".join(map(str, late)) + "\n")
+                proc.stdin.flush()
+                played += 1
+                log(f"  frame {f}: the controller's Load Monitor: {sum(late)} late line(s), busiest "
+                    f"line {max(iss)} slots ({time.time() - t0:.1f} s)")
+            proc.wait()
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    if proc.returncode:
+        raise RuntimeError(f"yproc anim {' '.join(flags)} --monitor-stdin failed:\n" + errpath.read_text())
+    st = json.loads((out / "anim_stats.json").read_text())
+    st["rtl_seconds"], st["frames_played"] = t_rtl, played
+    return st
+
+
+def plot_lod_rtl(outs: list, path) -> dict:
+    """The Verilated controller in the loop against yproc's model (`--lod-loop --rtl
+    --compare-model` writes OUT/loop and OUT/loop_model): per OUT, late lines and mean level
+    per frame of both runs, the lines whose level differs between them, and the mesh version
+    where the animation has tessellation. Returns a summary per OUT (also lod_rtl.json)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
+    cols = ["#4477aa", "#228833", "#cc6677", "#ddaa33"]
+    summary = {}
+    for i, o in enumerate(map(Path, outs)):
+        A = json.loads((o / "loop" / "anim_stats.json").read_text())
+        B = json.loads((o / "loop_model" / "anim_stats.json").read_text())
+        col, name = cols[i % len(cols)], f"{Path(A['anim']).name}{' + check' if A.get('lod_predict') else ''}"
+        diff = [sum(a != b for a, b in zip(x["levels"], y["levels"])) for x, y in zip(A["frame"], B["frame"])]
+        summary[str(o)] = {"anim": A["anim"], "predict": A.get("lod_predict", 0),
+                           "late_lines": sum(f["overflow_lines"] for f in A["frame"]),
+                           "frames_model_agrees": sum(f.get("model_agrees", 0) for f in A["frame"]),
+                           "frames": len(A["frame"]), "level_differences": sum(diff),
+                           "tess_same": [f.get("tess") for f in A["frame"]] == [f.get("tess") for f in B["frame"]]}
+        ax[0].plot([f["overflow_lines"] for f in A["frame"]], color=col, marker=".", label=f"{name}: RTL")
+        ax[0].plot([f["overflow_lines"] for f in B["frame"]], color=col, ls=":", lw=3, alpha=.6,
+                   label=f"{name}: model")
+        ax[1].plot([f["mean_level"] for f in A["frame"]], color=col, marker=".")
+        ax[1].plot([f["mean_level"] for f in B["frame"]], color=col, ls=":", lw=3, alpha=.6)
+        ax[2].plot(diff, color=col, marker=".", label=name)
+        if "tess" in A["frame"][0]:
+            tw = ax[1].twinx()
+            tw.step(range(len(A["frame"])), [f["tess"][0] for f in A["frame"]], where="mid", color="#aa3377",
+                    ls="--", label=f"{name}: mesh version (RTL run)")
+            tw.set_ylim(-0.2, 3)
+            tw.set_ylabel("mesh version", color="#aa3377")
+            tw.legend(fontsize=7, loc="upper right")
+    ax[0].set_title("late lines per frame (the controller's record)")
+    ax[0].set_xlabel("frame")
+    ax[0].legend(fontsize=6, loc="upper right")
+    ax[1].set_title("mean level per frame")
+    ax[1].set_xlabel("frame")
+    ax[1].set_ylim(0, 5.3)
+    ax[2].set_title("lines whose level differs, RTL against model")
+    ax[2].set_xlabel("frame")
+    ax[2].set_ylim(-0.5, 5)
+    ax[2].legend(fontsize=7)
+    fig.suptitle("The Verilated display controller's Load Monitor read back every frame "
+                 "(dotted: the same animation on yproc's model)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    Path(path).with_suffix(".json").write_text(json.dumps(summary, indent=1) + "\n")
+    return summary
 
 
 def configure(ap) -> None:
@@ -279,19 +466,78 @@ def configure(ap) -> None:
                     help="golden model of the changed lines: fast = the C functional model "
                          "(default), numpy = diffengine.model.functional")
     ap.add_argument("--lod-compare", action="store_true",
-                    help="instead: the animation three times (open loop, look-ahead degradation, "
-                         "Load Monitor loop): overflowing lines and quality per frame -> OUT/lod.png, "
+                    help="instead: the animation four times (open loop, look-ahead degradation, "
+                         "Load Monitor loop, the loop with the check before emission): overflowing lines and quality per frame -> OUT/lod.png, "
                          "lod.json (docs/yproc.md section 10)")
     ap.add_argument("--mode", choices=("640x480", "640x485", "1280x1024"),
                     help="with --lod-compare: the video mode (raster and slots per line) for yproc")
+    ap.add_argument("--lod-loop", action="store_true",
+                    help="instead: the Load Monitor loop once (yproc anim --lod-loop) -> OUT/loop")
+    ap.add_argument("--predict", action="store_true",
+                    help="with --lod-loop: each line also checked against the capacity before it "
+                         "is emitted (--lod-predict)")
+    ap.add_argument("--rtl", action="store_true",
+                    help="with --lod-loop: the per-line counts come from the Verilated display "
+                         "controller's Load Monitor, frame by frame, instead of yproc's model "
+                         "(test-mode geometry, HTotal 800 unless 640x480; slow at full size)")
+    ap.add_argument("--chips", type=int, help="with --rtl: chips per colour (default: the fewest "
+                    "that cover the width)")
+    ap.add_argument("--compare-model", action="store_true",
+                    help="with --lod-loop --rtl: also the same run on yproc's model (OUT/loop_model) "
+                         "and the comparison OUT/lod_rtl.png, lod_rtl.json")
+    ap.add_argument("--plot-rtl", nargs="+", metavar="OUT",
+                    help="instead: one plot of several --lod-loop --rtl --compare-model outputs -> "
+                         "--out/lod_rtl.png")
+    ap.add_argument("--htotal", type=int, help="with --rtl: the controller's HTotal in test mode, "
+                    "porches 4 + 8 (slots per line + 2; default 800, or the 640x480 mode)")
+    ap.add_argument("--capacity", type=int, help="with --lod-loop: yproc's slots per line "
+                    "(default: the mode's, or with --rtl the controller's HTotal - 2)")
     ap.set_defaults(func=command)
 
 
 def command(a) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.plot_rtl:
+        summary = plot_lod_rtl(a.plot_rtl, out / "lod_rtl.png")
+        for k, v in summary.items():
+            print(f"  {k}: {v}")
+        print(f"wrote {out / 'lod_rtl.png'}")
+        return 0
+    if a.lod_loop:
+        print(f"anim: {a.anim}: the Load Monitor loop{' + check before emission' if a.predict else ''}"
+              f"{', the Verilated controller in the loop' if a.rtl else ''}", flush=True)
+        try:
+            test = None
+            if a.htotal:
+                # short porches (front 4, sync 8) as in the tests' short lines
+                W, H = anim_screen(a.anim)
+                test = (W, 4, 8, a.htotal - W - 12, H, 1, 2, 2)
+                if test[3] < 1:
+                    raise ValueError(f"--htotal {a.htotal} leaves no back porch for width {W}")
+            st = lod_loop(a.anim, out / "loop", predict=a.predict, rtl=a.rtl, chips=a.chips, test=test,
+                          capacity=a.capacity, extra=("--mode", a.mode) if a.mode else ())
+        except (RuntimeError, ValueError) as e:
+            print(f"anim: error: {e}", file=sys.stderr)
+            return 1
+        ov = [f["overflow_lines"] for f in st["frame"]]
+        agree = [f.get("model_agrees", 1) for f in st["frame"]]
+        print(f"  late lines per frame {ov} (total {sum(ov)}); mean level per frame "
+              f"{[round(f['mean_level'], 2) for f in st['frame']]}")
+        if a.rtl:
+            print(f"  the controller's record equals yproc's model in {sum(agree)} of {len(agree)} "
+                  f"frames; RTL {st['rtl_seconds']:.0f} s for {st['frames_played']} frames")
+        if a.rtl and a.compare_model:
+            lod_loop(a.anim, out / "loop_model", predict=a.predict, capacity=st["capacity"],
+                     extra=("--mode", a.mode) if a.mode else ())
+            summary = plot_lod_rtl([out], out / "lod_rtl.png")[str(out)]
+            print(f"  the same on yproc's model: lines whose level differs {summary['level_differences']}, "
+                  f"mesh versions the same: {summary['tess_same']} ({out / 'lod_rtl.png'})")
+            agree.append(summary["level_differences"] == 0 and summary["tess_same"])
+        print(f"wrote {out / 'loop'}")
+        return 0 if st["frames_differing_from_full"] == 0 and all(agree) else 1
     if a.lod_compare:
-        print(f"anim: {a.anim} three times (open loop, look-ahead, Load Monitor loop)", flush=True)
+        print(f"anim: {a.anim} four times (open loop, look-ahead, Load Monitor loop, loop + check)", flush=True)
         try:
             lod_compare(a.anim, out, ("--mode", a.mode) if a.mode else ())
         except RuntimeError as e:

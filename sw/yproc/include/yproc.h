@@ -148,5 +148,48 @@ const unsigned char *yp_lod_levels(const yp_lod *l);     /* [height], for yp_opt
  * all lines, and the same for its two neighbours.  Returns the lines whose level
  * changed. */
 int yp_lod_update(yp_lod *l, const int *issued, const int *late);
+/* The y-processor's own check before a frame is emitted (docs/yproc.md section 10): it
+ * knows every line's instruction count when it has built it, so a line of fr (scanned
+ * with o->line_lod == yp_lod_levels(l)) whose count in some colour exceeds the capacity
+ * (a line the Load Monitor would record late) is lowered one level and re-scanned, until
+ * it fits or is at level 0.  The exact counts at both levels set the line's cost ratio, and
+ * the level above is barred as after a failed raise.  *lowered: lines lowered; [*y0, *y1)
+ * (may be NULL) widened by the re-scanned lines.  The frame then equals a full scan at the
+ * new levels. */
+hsr_status yp_lod_fit(yp_lod *l, const yp_shader *sh, const hsr_ctx *h, const yp_options *o,
+                      yp_frame *fr, int *lowered, int *y0, int *y1);
+
+/* ---- tessellation as a level of detail (yp_tess.c, docs/yproc.md section 10) ----
+ * `tessellation OBJ CELL [VERSIONS]` in an .anim: versions 1..VERSIONS-1 of obj statement
+ * OBJ made by vertex clustering with grid cells CELL, 2 CELL, 4 CELL ... (world units),
+ * appended to the scene as obj statements; the version shown follows OBJ's moves, the
+ * others are parked behind the eye (empty domains).  A change takes effect at the next
+ * yp_anim_apply (an ordinary move for the incremental HSR: its lines are damaged). */
+#define YP_TESS_MAX 6
+typedef struct yp_tess yp_tess;
+yp_tess *yp_anim_tess(yp_anim *a);                 /* NULL: no tessellation statement */
+int yp_tess_count(const yp_tess *t);               /* objects with coarser versions */
+int yp_tess_versions(const yp_tess *t, int k);     /* versions of object k, its own mesh (0) included */
+int yp_tess_get(const yp_tess *t, int k);          /* the version shown, 0 = the finest */
+int yp_tess_obj(const yp_tess *t, int k, int v);   /* the scene's obj index of version v */
+hsr_status yp_tess_set(yp_tess *t, int k, int v);
+/* The loop's rules (tessellation is below level 0: the finest mesh the lines can carry at
+ * some level is kept): an object whose shown version covers a line in stuck[] (over the
+ * capacity at level 0, after yp_lod_fit) goes one version coarser, and the finer one waits
+ * 4 frames, doubling at each failed try (up to 256).  An object that has been at its
+ * version for 6 frames, none of whose lines is at level 0 (line_lod), tries the finer one:
+ * the check before emission makes it coarser again if it does not fit, so a try costs
+ * host time, never a late line.  frame: the frame's number.  Both return the objects
+ * changed. */
+int yp_tess_coarsen(yp_tess *t, const hsr_scene *sc, const hsr_ctx *h, const unsigned char *stuck, int frame);
+int yp_tess_refine(yp_tess *t, const hsr_scene *sc, const hsr_ctx *h, const unsigned char *line_lod, int frame);
+/* The check before emission of frame f of an animation (yproc anim --lod-predict):
+ * yp_lod_fit, then, while lines are still over the capacity at level 0, yp_tess_coarsen
+ * on them, the frame applied again (yp_anim_apply: the switch is a move for the
+ * incremental HSR), its damaged lines re-scanned and yp_lod_fit again.  fr holds frame f
+ * scanned at o->line_lod == yp_lod_levels(lod); [*y0, *y1) is widened by the re-scanned
+ * lines; *lowered, *coarsened: lines lowered, objects made coarser. */
+hsr_status yp_lod_fit_anim(yp_lod *lod, yp_anim *an, int f, hsr_ctx *h, yp_shader *sh, const yp_options *o,
+                           yp_frame *fr, int *lowered, int *coarsened, int *y0, int *y1);
 
 #endif

@@ -22,7 +22,9 @@ struct yp_anim {
     double *cur_off;                   /* per obj: current translation */
     int *vobj;                         /* per vertex: obj index or -1 */
     yp_animx *x;                       /* point lights, wander, textures (yp_tex.c) */
+    yp_tess *tess;                     /* coarser versions of objects (yp_tess.c) */
 };
+yp_tess *yp_anim_tess(yp_anim *a) { return a ? a->tess : NULL; }
 
 int yp_anim_frames(const yp_anim *a) { return a ? a->frames : 0; }
 hsr_scene *yp_anim_scene(yp_anim *a) { return a ? a->sc : NULL; }
@@ -32,7 +34,7 @@ void yp_anim_free(yp_anim *a)
     if (!a) return;
     hsr_scene_free(a->sc);
     free(a->base_v); free(a->base_op); free(a->act); free(a->cur_off); free(a->vobj);
-    yp_animx_free(a->x); free(a);
+    yp_animx_free(a->x); yp_tess_free(a->tess); free(a);
 }
 
 static double ramp(const action *c, int f)
@@ -111,6 +113,7 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
         } else {
             char m[512];
             int r = a->sc ? yp_animx_parse(&a->x, a->sc, tok, nt, m, sizeof m) : 0;
+            if (r == 0 && a->sc) r = yp_tess_parse(&a->tess, a->sc, tok, nt, m, sizeof m);
             if (r < 0) AFAIL("%s", m);
             if (r == 0) AFAIL("unknown statement '%s'", tok[0]);
         }
@@ -165,6 +168,7 @@ hsr_status yp_anim_apply(yp_anim *a, int fr, hsr_ctx *h, yp_shader *sh, int *y0,
         double r = ramp(c, fr);
         if (c->kind == A_MOVE) for (int k = 0; k < 3; k++) off[3 * c->target + k] += r * c->v[k];
     }
+    yp_tess_offsets(a->tess, sc, off);   /* the versions shown and parked */
     for (int o = 0; o < sc->nobj; o++)
         for (int k = 0; k < 3; k++) if (off[3 * o + k] != a->cur_off[3 * o + k]) moved[o] = 1;
     for (int v = 0; v < sc->nv; v++) {

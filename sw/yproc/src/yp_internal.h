@@ -56,6 +56,12 @@ typedef struct yp_animx yp_animx;
 int yp_animx_parse(yp_animx **x, const hsr_scene *sc, char **tok, int nt, char *msg, size_t msglen);
 int yp_animx_apply(yp_animx *x, int f, yp_shader *sh, hsr_status *st);
 void yp_animx_free(yp_animx *x);
+/* yp_tess.c: the `tessellation` statement (1 taken, 0 not ours, -1 error in msg; appends
+ * the clustered versions to sc), the offsets of the versions (each follows its object's
+ * move in off[3 * obj], the hidden ones parked behind the eye), and free */
+int yp_tess_parse(yp_tess **t, hsr_scene *sc, char **tok, int nt, char *msg, size_t msglen);
+void yp_tess_offsets(const yp_tess *t, const hsr_scene *sc, double *off);
+void yp_tess_free(yp_tess *t);
 
 /* yp_cover.c: signed-area accumulation of a closed ring set (pixel
  * coordinates relative to the buffer origin) into acc (ny rows of

@@ -36,9 +36,13 @@ void yp_lod_monitor(const int *slots, int n, int capacity, int *issued, int *lat
 {
     long drain = 0;   /* words of a late line still to be discarded (its marker included) */
     for (int l = 0; l < n; l++) {
-        long room = capacity + 1 - drain;          /* slots of this window after the discard */
-        drain = room < 0 ? -room : 0;
-        if (room < 0) room = 0;
+        /* slots of this window after the discard.  A discard longer than the window goes on
+         * through the line's last cycle, outside the window (HTotal = capacity + 2 cycles per
+         * line): in a cascade of late lines the tail shrinks by one word more per line than
+         * the window (found with the Verilated controller in the loop, docs/yproc.md 10) */
+        long room;
+        if (drain > capacity + 1) { room = 0; drain -= capacity + 2; }
+        else { room = capacity + 1 - drain; drain = 0; }
         int sl = slots[l];                          /* slots and issued may be one array */
         late[l] = sl + 1 > room;
         issued[l] = late[l] ? (int)room : sl;
@@ -51,6 +55,10 @@ void yp_lod_monitor(const int *slots, int n, int capacity, int *issued, int *lat
 #define BACKOFF0 4      /* frames before a level that was late is tried again (doubling) */
 #define RMIN 1.25       /* smallest cost ratio between levels believed (measurements during
                          * motion mix the level's cost with the load's change) */
+#define PROBE 8         /* with yp_lod_fit: frames at a level before the next one is probed */
+#define ROPT 2.0        /* with yp_lod_fit: the largest learned ratio used for a line whose own
+                         * is unknown (a raise that does not fit is lowered again before it is
+                         * emitted: it costs a re-scan, not an overflow) */
 
 struct yp_lod {
     int H, cap;
@@ -64,9 +72,11 @@ struct yp_lod {
     int *rll;                 /* per line and level: the load at that level when rl was set */
     int *barl;                /* per line and level: the load one level below when the level was
                                * barred (first frame after); the bar lifts when it falls by 30 % */
+    int *since;               /* per line: frames at its level (yp_lod_fit's lowering included) */
     unsigned char *pending;   /* per line: late last frame, bound the ratio from this frame's load */
     double *pred;             /* per line: its load predicted one level up */
     int frame;
+    int fitted;               /* yp_lod_fit guards the frames: raise on an optimistic ratio */
     double ratio[YP_LOD_MAX]; /* learned load(k + 1) / load(k) */
 };
 
@@ -85,8 +95,9 @@ hsr_status yp_lod_new(int height, int capacity, yp_lod **out)
     l->rll = calloc((size_t)height * (YP_LOD_MAX + 1), sizeof(int));
     l->barl = calloc((size_t)height * (YP_LOD_MAX + 1), sizeof(int));
     l->pending = calloc((size_t)height, 1);
+    l->since = calloc((size_t)height, sizeof(int));
     l->pred = calloc((size_t)height, sizeof(double));
-    if (!l->lev || !l->prev_lev || !l->prev_issued || !l->block || !l->backoff || !l->rl || !l->rll || !l->barl || !l->pending || !l->pred) { yp_lod_free(l); return HSR_ENOMEM; }
+    if (!l->lev || !l->prev_lev || !l->prev_issued || !l->block || !l->backoff || !l->rl || !l->rll || !l->barl || !l->pending || !l->pred || !l->since) { yp_lod_free(l); return HSR_ENOMEM; }
     memset(l->lev, YP_LOD_MAX, (size_t)height);
     memset(l->prev_lev, YP_LOD_MAX, (size_t)height);
     for (int y = 0; y < height; y++) l->prev_issued[y] = -1;
@@ -98,7 +109,7 @@ hsr_status yp_lod_new(int height, int capacity, yp_lod **out)
 void yp_lod_free(yp_lod *l)
 {
     if (!l) return;
-    free(l->lev); free(l->prev_lev); free(l->prev_issued); free(l->block); free(l->backoff); free(l->rl); free(l->rll); free(l->barl); free(l->pending); free(l->pred); free(l);
+    free(l->lev); free(l->prev_lev); free(l->prev_issued); free(l->block); free(l->backoff); free(l->rl); free(l->rll); free(l->barl); free(l->pending); free(l->pred); free(l->since); free(l);
 }
 
 const unsigned char *yp_lod_levels(const yp_lod *l) { return l ? l->lev : NULL; }
@@ -150,7 +161,8 @@ int yp_lod_update(yp_lod *l, const int *issued, const int *late)
             rll[pl] = pi;
         }
         l->pending[y] = (unsigned char)own;
-        l->pred[y] = lv < YP_LOD_MAX ? issued[y] * (rl[lv] > 0 ? rl[lv] : l->ratio[lv]) : issued[y];
+        double gr = l->fitted ? fmin(l->ratio[lv < YP_LOD_MAX ? lv : 0], ROPT) : l->ratio[lv < YP_LOD_MAX ? lv : 0];
+        l->pred[y] = lv < YP_LOD_MAX ? issued[y] * (rl[lv] > 0 ? rl[lv] : gr) : issued[y];
     }
     for (int y = 0; y < H; y++) {
         int lv = l->lev[y], nl = lv;
@@ -169,7 +181,7 @@ int yp_lod_update(yp_lod *l, const int *issued, const int *late)
              * lines (the load one level down may not show that what overflowed is gone) */
             l->rl[y * (YP_LOD_MAX + 1) + lv] = 0;
             bl[lv + 1] = 0;
-            pred = issued[y] * l->ratio[lv];
+            pred = issued[y] * (l->fitted ? fmin(l->ratio[lv], ROPT) : l->ratio[lv]);
         }
         if (y > 0 && l->pred[y - 1] > pred) pred = l->pred[y - 1];
         if (y + 1 < H && l->pred[y + 1] > pred) pred = l->pred[y + 1];
@@ -189,9 +201,12 @@ int yp_lod_update(yp_lod *l, const int *issued, const int *late)
             bo[lv] = bo[lv] ? 2 * bo[lv] : BACKOFF0;
             if (bo[lv] > 256) bo[lv] = 256;
             bl[lv] = l->frame + bo[lv];
-        } else if (issued[y] > HIGH * cap) {
+        } else if (issued[y] > (l->fitted ? 1.0 : HIGH) * cap) {
             nl = lv > 0 ? lv - 1 : 0;
-        } else if (lv < YP_LOD_MAX && pred < RAISE * cap && l->frame >= bl[lv + 1]) {
+        } else if (lv < YP_LOD_MAX && l->frame >= bl[lv + 1]
+                   && (pred < RAISE * cap || (l->fitted && l->since[y] >= PROBE))) {
+            /* with yp_lod_fit a line also probes the next level after PROBE frames at its
+             * own: a raise that does not fit is lowered before it is emitted */
             nl = lv + 1;
             barl[nl] = 0;
         } else if (l->frame >= bl[lv] + 4 * bo[lv]) {
@@ -200,8 +215,78 @@ int yp_lod_update(yp_lod *l, const int *issued, const int *late)
         l->prev_lev[y] = (unsigned char)lv;
         l->prev_issued[y] = issued[y];
         l->lev[y] = (unsigned char)nl;
+        l->since[y] = nl != lv || l->prev_lev[y] != lv ? 0 : l->since[y] + 1;
         changed += nl != lv;
     }
     l->frame++;
     return changed;
+}
+
+/* the largest slot count of line y over the three colours */
+static int line_slots(const yp_frame *fr, int y)
+{
+    int s = 0;
+    for (int c = 0; c < 3; c++) if (fr->st[y].slots[c] > s) s = fr->st[y].slots[c];
+    return s;
+}
+
+hsr_status yp_lod_fit(yp_lod *l, const yp_shader *sh, const hsr_ctx *h, const yp_options *o,
+                      yp_frame *fr, int *lowered, int *y0, int *y1)
+{
+    if (lowered) *lowered = 0;
+    if (!l || !sh || !h || !o || !fr || o->line_lod != l->lev || fr->height != l->H) return HSR_EINVAL;
+    const int H = l->H, L1 = YP_LOD_MAX + 1;
+    int *above = malloc(sizeof(int) * (size_t)H);   /* slots one level up of a lowered line, 0 if none */
+    unsigned char *now = calloc((size_t)H, 1);
+    if (!above || !now) { free(above); free(now); return HSR_ENOMEM; }
+    hsr_status st = HSR_OK;
+    int n = 0;
+    l->fitted = 1;
+    for (int y = 0; y < H; y++) above[y] = 0;
+    for (;;) {
+        int any = 0;
+        for (int y = 0; y < H; y++) {
+            int s = line_slots(fr, y);
+            now[y] = s > l->cap && l->lev[y] > 0;
+            if (!now[y]) continue;
+            n += !above[y];
+            above[y] = s;
+            l->lev[y]--;
+            any = 1;
+        }
+        if (!any) break;
+        /* re-scan the runs of lowered lines (runs closer than 8 lines together: one scan
+         * of a few lines costs about as much as the coverage of the groups it touches) */
+        for (int y = 0; y < H && st == HSR_OK;) {
+            if (!now[y]) { y++; continue; }
+            int a = y, b = y + 1;
+            for (int g = b; g < H && g < b + 8; g++) if (now[g]) b = g + 1;
+            while (b < H && now[b]) b++;
+            st = yp_scan(sh, h, o, a, b, fr);
+            if (y0 && y1) {
+                if (*y0 >= *y1) { *y0 = a; *y1 = b; }
+                if (a < *y0) *y0 = a;
+                if (b > *y1) *y1 = b;
+            }
+            y = b;
+        }
+        if (st != HSR_OK) break;
+    }
+    /* what the fit learned: the cost ratio between the line's level and the one above it
+     * (both counts known exactly), and the level above is barred like a failed raise */
+    for (int y = 0; y < H && st == HSR_OK; y++) {
+        if (!above[y]) continue;
+        int k = l->lev[y], s = line_slots(fr, y);
+        if (k >= YP_LOD_MAX) continue;
+        double *rl = &l->rl[y * L1];
+        int *rll = &l->rll[y * L1], *bo = &l->backoff[y * L1], *bl = &l->block[y * L1];
+        if (s > 0) { rl[k] = fmax(RMIN, (double)above[y] / s); rll[k] = s; }
+        bo[k + 1] = bo[k + 1] ? 2 * bo[k + 1] : BACKOFF0;
+        if (bo[k + 1] > 256) bo[k + 1] = 256;
+        bl[k + 1] = l->frame + bo[k + 1];
+        l->barl[y * L1 + k + 1] = 0;
+    }
+    free(above); free(now);
+    if (lowered) *lowered = n;
+    return st;
 }

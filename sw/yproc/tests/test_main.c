@@ -3,6 +3,7 @@
 #include "t.h"
 
 void suite_yp_tex_lod(void);   /* test_yp_tex_lod.c */
+void suite_yp_tess(void);      /* test_yp_tess.c */
 
 int main(int argc, char **argv)
 {
@@ -11,5 +12,6 @@ int main(int argc, char **argv)
     suite_yp();
     suite_obj_shading();
     suite_yp_tex_lod();
+    suite_yp_tess();
     return t_report();
 }

@@ -26,6 +26,8 @@ typedef struct opts {
     yp_options yo;
     int frames, cmd, expect, full, width, height, mode_given;
     int lod_loop;        /* anim: per-line level of detail from the Load Monitor model */
+    int lod_predict;     /* anim: and each line checked against the capacity before it is emitted */
+    int monitor_stdin;   /* anim: the monitor's record per frame from stdin (the Verilated controller) */
     int lod_all;         /* scan: every line at this level of detail (-1: the options) */
 } opts;
 
@@ -44,6 +46,8 @@ static int parse(int argc, char **argv, opts *o)
         else if (!strcmp(a, "--full")) o->full = 1;
         else if (!strcmp(a, "--no-degrade")) o->yo.no_degrade = 1;
         else if (!strcmp(a, "--lod-loop")) { o->lod_loop = 1; o->yo.no_degrade = 1; }
+        else if (!strcmp(a, "--lod-predict")) { o->lod_loop = o->lod_predict = 1; o->yo.no_degrade = 1; }
+        else if (!strcmp(a, "--monitor-stdin")) o->monitor_stdin = 1;
         else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
                  && strcmp(a, "--tol") && strcmp(a, "--capacity") && strcmp(a, "--lod"))
             return yproc_usage_error("unknown option", a);
@@ -73,6 +77,7 @@ static int parse(int argc, char **argv, opts *o)
         }
     }
     if (!o->out) return yproc_usage_error("missing -o OUTDIR", NULL);
+    if (o->monitor_stdin && !o->lod_loop) return yproc_usage_error("--monitor-stdin needs --lod-loop or --lod-predict", NULL);
     o->yo.capacity = yp_mode_capacity(o->mode, &o->width, &o->height);
     if (!o->yo.capacity) { fprintf(stderr, "yproc: unknown mode '%s' (640x480, 640x485, 1280x1024)\n", o->mode); return 1; }
     if (cap) o->yo.capacity = cap;
@@ -301,17 +306,54 @@ static int copy_lines(yp_cmdlist *dst, const yp_frame *fr)
 /* the frame as the Load Monitor records it (yp_lod_monitor, per line: the
  * largest count of the three colours, late if any is): overflowing lines, the mean
  * level of detail and, with the loop, the levels of the next frame after the update */
-static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap)
+/* --monitor-stdin: "monitor F" on stdout, then one line on stdin: F, then H issued
+ * counts and H late flags (0/1), as the Verilated controller's Load Monitor recorded
+ * frame F (the largest count of the three colours, late if any was).  0 on success. */
+static int read_monitor(int frame, int H, int *iss, int *late)
 {
-    int H = fr->height, ovl = 0, *iss = calloc(4 * (size_t)H + 1, sizeof(int));
+    printf("monitor %d\n", frame);
+    fflush(stdout);
+    char *line = NULL;
+    size_t cap = 0;
+    if (getline(&line, &cap, stdin) < 0) { free(line); fprintf(stderr, "yproc: frame %d: no monitor record on stdin\n", frame); return 1; }
+    char *p = line, *end;
+    long v = strtol(p, &end, 10);
+    int bad = end == p || v != frame;
+    for (int i = 0; i < 2 * H && !bad; i++) {
+        p = end;
+        v = strtol(p, &end, 10);
+        if (end == p || v < 0 || (i >= H && v > 1)) bad = 1;
+        else if (i < H) iss[i] = (int)v; else late[i - H] = (int)v;
+    }
+    free(line);
+    if (bad) fprintf(stderr, "yproc: frame %d: bad monitor record on stdin (want: %d, %d issued counts, %d late flags)\n", frame, frame, H, H);
+    return bad;
+}
+
+static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap, int frame, int from_stdin, int lowered)
+{
+    int H = fr->height, ovl = 0, *iss = calloc(6 * (size_t)H + 1, sizeof(int));
     if (!iss) return 1;
-    int *late = iss + H, *ic = iss + 2 * H, *lc = iss + 3 * H;
+    int *late = iss + H, *ic = iss + 2 * H, *lc = iss + 3 * H, *riss = iss + 4 * H, *rlate = iss + 5 * H;
     for (int c = 0; c < 3; c++) {
         for (int y = 0; y < H; y++) ic[y] = fr->st[y].slots[c];
         yp_lod_monitor(ic, H, cap, ic, lc);
         for (int y = 0; y < H; y++) { if (ic[y] > iss[y]) iss[y] = ic[y]; late[y] |= lc[y]; }
     }
+    if (from_stdin) {
+        /* the loop reads the controller's record; the model's is kept for comparison */
+        if (read_monitor(frame, H, riss, rlate)) { free(iss); return 1; }
+        int agree = 1;
+        for (int y = 0; y < H; y++) agree &= riss[y] == iss[y] && rlate[y] == late[y];
+        fprintf(js, ", \"monitor\": \"stdin\", \"model_agrees\": %d, \"model_overflow_lines\": ", agree);
+        int mo = 0;
+        for (int y = 0; y < H; y++) mo += late[y];
+        fprintf(js, "%d", mo);
+        memcpy(iss, riss, sizeof(int) * (size_t)H);
+        memcpy(late, rlate, sizeof(int) * (size_t)H);
+    }
     for (int y = 0; y < H; y++) ovl += late[y];
+    fprintf(js, ", \"lowered_before_emit\": %d", lowered);
     const unsigned char *lv = yp_lod_levels(lod);
     double mean = YP_LOD_MAX;
     if (lv) { mean = 0; for (int y = 0; y < H; y++) mean += lv[y]; mean /= H; }
@@ -320,9 +362,19 @@ static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap)
     fprintf(js, "], \"issued\": [");
     for (int y = 0; y < H; y++) fprintf(js, "%s%d", y ? ", " : "", iss[y]);
     fprintf(js, "]");
+    /* the levels the frame was emitted at are printed above; the update sets the next's */
     if (lod) yp_lod_update(lod, iss, late);
     free(iss);
     return 0;
+}
+
+static void tess_json(FILE *js, yp_anim *an, int coarsened)
+{
+    yp_tess *t = yp_anim_tess(an);
+    if (!t) return;
+    fprintf(js, ", \"tess_coarsened\": %d, \"tess\": [", coarsened);
+    for (int k = 0; k < yp_tess_count(t); k++) fprintf(js, "%s%d", k ? ", " : "", yp_tess_get(t, k));
+    fprintf(js, "]");
 }
 
 static int anim_main(opts *o)
@@ -356,7 +408,10 @@ static int anim_main(opts *o)
     double t0 = now_ms();
     if ((st = hsr_scene_build(sc, &h, &shade)) != HSR_OK) { fprintf(stderr, "%s: %s\n", o->in, hsr_status_str(st)); rc = 1; goto out; }
     free(shade);
-    if (yp_frame_new(W, H, &fr) != HSR_OK || yp_scan(sh, h, &o->yo, 0, H, fr) != HSR_OK) { rc = 1; goto out; }
+    int lowered = 0, coarsened = 0, fy0 = 0, fy1 = H;
+    if (yp_frame_new(W, H, &fr) != HSR_OK || yp_scan(sh, h, &o->yo, 0, H, fr) != HSR_OK
+        || (o->lod_predict && yp_lod_fit_anim(lod, an, 0, h, sh, &o->yo, fr, &lowered, &coarsened, &fy0, &fy1) != HSR_OK)) { rc = 1; goto out; }
+    if (lod) memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
     double t1 = now_ms();
     if (mkdir_p(o->out)) { rc = 1; goto out; }
     snprintf(p, sizeof p, "%s/frame000", o->out);
@@ -365,9 +420,20 @@ static int anim_main(opts *o)
     FILE *js = fopen(p, "w");
     if (!js) { rc = 1; goto out; }
     fprintf(js, "{\"format\": \"yproc-anim-1\", \"anim\": \"%s\", \"frames\": %d, \"width\": %d, \"height\": %d, "
-                "\"capacity\": %d, \"lod_loop\": %d, \"no_degrade\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f",
-            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->yo.no_degrade, t1 - t0);
-    if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; fclose(js); goto out; }
+                "\"capacity\": %d, \"lod_loop\": %d, \"lod_predict\": %d, \"no_degrade\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f",
+            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->lod_predict, o->yo.no_degrade, t1 - t0);
+    tess_json(js, an, coarsened);
+    for (int k = 0; k < yp_tess_count(yp_anim_tess(an)); k++) {
+        /* faces of each version (the scene's obj statements of the clustered meshes) */
+        fprintf(js, "%s[", k ? ", " : ", \"tess_faces\": [");
+        for (int v = 0; v < yp_tess_versions(yp_anim_tess(an), k); v++) {
+            int nfo = 0, ob = yp_tess_obj(yp_anim_tess(an), k, v);
+            for (int fi = 0; fi < sc->nf; fi++) nfo += sc->f[fi].obj == ob;
+            fprintf(js, "%s%d", v ? ", " : "", nfo);
+        }
+        fprintf(js, "]%s", k + 1 == yp_tess_count(yp_anim_tess(an)) ? "]" : "");
+    }
+    if (lod_stats(js, fr, lod, o->yo.capacity, 0, o->monitor_stdin, lowered)) { rc = 1; fclose(js); goto out; }
     fprintf(js, "}");
     double sum_inc = 0, sum_full = 0, sum_inc_scan = 0, sum_full_scan = 0;
     long sum_changed = 0;
@@ -375,6 +441,9 @@ static int anim_main(opts *o)
     for (int f = 1; f < F && !rc; f++) {
         int y0, y1;
         double a0 = now_ms();
+        /* tessellation: an object whose lines are all back at full quality tries its finer
+         * mesh (the check below makes it coarser again if a line then does not fit) */
+        if (o->lod_predict && yp_anim_tess(an)) yp_tess_refine(yp_anim_tess(an), sc, h, yp_lod_levels(lod), f);
         st = yp_anim_apply(an, f, h, sh, &y0, &y1);
         /* lines whose level of detail changed are re-scanned too */
         for (int y = 0; lod && y < H; y++)
@@ -382,6 +451,12 @@ static int anim_main(opts *o)
         if (lod) memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
         double am = now_ms();
         if (st == HSR_OK) st = yp_scan(sh, h, &o->yo, y0, y1, fr);
+        /* the y-processor's own check: lines over the capacity lowered before they are emitted */
+        lowered = coarsened = 0;
+        if (st == HSR_OK && o->lod_predict) {
+            st = yp_lod_fit_anim(lod, an, f, h, sh, &o->yo, fr, &lowered, &coarsened, &y0, &y1);
+            memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
+        }
         double a1 = now_ms();
         if (st != HSR_OK) { fprintf(stderr, "%s: frame %d: %s\n", o->in, f, hsr_status_str(st)); rc = 1; break; }
         int nch[3] = {0, 0, 0};
@@ -426,7 +501,8 @@ static int anim_main(opts *o)
         for (int c = 0; c < 3; c++)
             for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chslots[c * H + y], y == H - 1 ? "]" : "");
         fprintf(js, "]");
-        if (lod_stats(js, fr, lod, o->yo.capacity)) { rc = 1; break; }
+        tess_json(js, an, coarsened);
+        if (lod_stats(js, fr, lod, o->yo.capacity, f, o->monitor_stdin, lowered)) { rc = 1; break; }
         fprintf(js, "}");
         printf("frame %3d: lines %3d..%3d rescanned, changed r/g/b %d/%d/%d; incremental %.1f ms (hsr %.1f + scan %.1f), "
                "full %.1f ms (hsr %.1f + scan %.1f)%s\n", f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am,
