@@ -72,9 +72,10 @@ demo: $(SETUP)
 	  --out $(OUT) $(if $(filter 0,$(RTL)),--no-rtl,)
 
 # The shipped animation through incremental frame deltas (out/anim: PNGs and a GIF).
+# ANIMFLAGS: more options of `diffengine anim`, e.g. "--coherent --tol 4" (docs/yproc.md 11).
 ANIM ?= sw/scenes/anim/cad_drag.anim
 anim: $(SETUP)
-	$(ENV) $(DE) anim --anim $(ANIM) --out $(OUT)/anim
+	$(ENV) $(DE) anim --anim $(ANIM) --out $(OUT)/anim $(ANIMFLAGS)
 
 # The interactive viewer (docs/viewer.md): SCENE given on the command line, else the CAD scene.
 VIEW_SCENE := $(if $(filter command line environment,$(origin SCENE)),$(SCENE),sw/scenes/cad/cad.scene)

@@ -37,10 +37,8 @@ module chip_top #(
 
   logic             rst_q, cfg_mode_q, cfg_bit_q, obs_load_q, obs_shift_q, obs_bit_q;
   logic [InW-1:0]   sh_q;
-  logic [11:0]      id_o;
-  logic [35:0]      data_o;
-  logic             pix_valid_o, collision_o;
-  logic [11:0]      pix_o;
+  de_pkg::link_t    link_o;
+  de_pkg::chain_t   chain_o;
   logic [NumPe-1:0] bypass_o;
   logic [NGrp*Grp-1:0] out_vec;
   logic [NGrp-1:0]  fold1_q;
@@ -59,26 +57,19 @@ module chip_top #(
   de_chip #(.NumPe(NumPe), .CarryBug(CarryBug)) u_chip (
     .clk_i,
     .rst_i      (rst_q),
-    .id_i       (sh_q[11:0]),
-    .data_i     (sh_q[47:12]),
-    .id_o,
-    .data_o,
-    .pix_valid_i(sh_q[48]),
-    .pix_i      (sh_q[60:49]),
-    .pix_valid_o,
-    .pix_o,
-    .cfg_mode_i (cfg_mode_q),
-    .cfg_bit_i  (cfg_bit_q),
-    .cfg_bit_o,
-    .obs_load_i (obs_load_q),
-    .obs_shift_i(obs_shift_q),
-    .obs_bit_i  (obs_bit_q),
-    .obs_bit_o,
-    .bypass_o,
-    .collision_o
+    // id, data, pix_valid, pix from the shift register; de_chip does not use link_i.coll
+    .link_i     ({sh_q[11:0], sh_q[47:12], sh_q[48], sh_q[60:49], 1'b0}),
+    .link_o,
+    .chain_ctl_i({cfg_mode_q, obs_load_q, obs_shift_q}),
+    .chain_i    ({cfg_bit_q, obs_bit_q}),
+    .chain_o,
+    .bypass_o
   );
 
-  assign out_vec = (NGrp * Grp)'({collision_o, bypass_o, pix_o, pix_valid_o, data_o, id_o});
+  assign out_vec = (NGrp * Grp)'({link_o.coll, bypass_o, link_o.pix, link_o.pix_valid,
+                                  link_o.data, link_o.id});
+  assign cfg_bit_o = chain_o.cfg;
+  assign obs_bit_o = chain_o.obs;
 
   always_ff @(posedge clk_i) begin
     for (int g = 0; g < NGrp; g++) fold1_q[g] <= ^out_vec[g*Grp +: Grp];

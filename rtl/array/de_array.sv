@@ -44,28 +44,19 @@ module de_array
     $fatal(1, "de_array: CarryBug must be 0 or 1");
   end
 
-  logic [NumChips:0][IdW-1:0]   id_c;
-  logic [NumChips:0][DataW-1:0] data_c;
-  logic [NumChips:0]            pixv_c, cfg_c, obs_c;
-  logic [NumChips:0][PixW-1:0]  pix_c;
-  logic [NumChips-1:0]          coll_c;
+  // What chip c receives (link_c[c], chain_c[c]) and passes on (link_c[c+1]).
+  link_t  [NumChips:0] link_c;
+  chain_t [NumChips:0] chain_c;
+  logic   [NumChips-1:0] coll_c;
   // Bypass bits per chip: visible in waves and to testbenches through the hierarchy.
   /* verilator lint_off UNUSEDSIGNAL */
   logic [NumChips-1:0][NumPe-1:0] bypass_c;
   /* verilator lint_on UNUSEDSIGNAL */
-  logic [11:0] skew_id;
-  logic [11:0] skew_b0, skew_b1, skew_b2;
 
-  de_skew u_skew (
-    .clk_i, .rst_i, .id_i, .data_i,
-    .id_o(skew_id), .blk0_o(skew_b0), .blk1_o(skew_b1), .blk2_o(skew_b2)
-  );
-  assign id_c[0]   = skew_id;
-  assign data_c[0] = {skew_b2, skew_b1, skew_b0};
-  assign pixv_c[0] = 1'b0;
-  assign pix_c[0]  = '0;
-  assign cfg_c[0]  = cfg_bit_i;
-  assign obs_c[0]  = 1'b0;
+  // Chip 0 takes the skewed bus and no pixel; the chains enter there too.
+  de_skew u_skew (.clk_i, .rst_i, .id_i, .data_i, .id_o(link_c[0].id), .blk_o(link_c[0].data));
+  assign {link_c[0].pix_valid, link_c[0].pix, link_c[0].coll} = '0;
+  assign chain_c[0] = {cfg_bit_i, 1'b0};
 
   for (genvar c = 0; c < NumChips; c++) begin : g_chip
     de_chip #(
@@ -74,26 +65,19 @@ module de_array
       .FaultMask(32'(FaultMask[c*NumPe +: NumPe]))
     ) u_chip (
       .clk_i, .rst_i,
-      .id_i       (id_c[c]),     .data_i     (data_c[c]),
-      .id_o       (id_c[c+1]),   .data_o     (data_c[c+1]),
-      .pix_valid_i(pixv_c[c]),   .pix_i      (pix_c[c]),
-      .pix_valid_o(pixv_c[c+1]), .pix_o      (pix_c[c+1]),
-      .cfg_mode_i,
-      .cfg_bit_i  (cfg_c[c]),    .cfg_bit_o  (cfg_c[c+1]),
-      .obs_load_i, .obs_shift_i,
-      .obs_bit_i  (obs_c[c]),    .obs_bit_o  (obs_c[c+1]),
-      .bypass_o   (bypass_c[c]),
-      .collision_o(coll_c[c])
+      .link_i     (link_c[c]),
+      .link_o     (link_c[c+1]),
+      .chain_ctl_i({cfg_mode_i, obs_load_i, obs_shift_i}),
+      .chain_i    (chain_c[c]),
+      .chain_o    (chain_c[c+1]),
+      .bypass_o   (bypass_c[c])
     );
+    assign coll_c[c] = link_c[c+1].coll;
   end
 
   de_deskew u_deskew (
     .clk_i, .rst_i,
-    .id_i   (id_c[NumChips]),
-    .blk0_i (data_c[NumChips][11:0]),
-    .blk1_i (data_c[NumChips][23:12]),
-    .blk2_i (data_c[NumChips][35:24]),
-    .id_o, .data_o
+    .id_i (link_c[NumChips].id), .blk_i(link_c[NumChips].data), .id_o, .data_o
   );
 
   logic coll_d, coll_q;
@@ -103,13 +87,13 @@ module de_array
     else       coll_q <= coll_d;
   end
 
-  assign pix_valid_o     = pixv_c[NumChips];
-  assign pix_o           = pix_c[NumChips];
+  assign pix_valid_o     = link_c[NumChips].pix_valid;
+  assign pix_o           = link_c[NumChips].pix;
   assign n_pe_o          = 16'(NumChips * NumPe);
   assign pix_collision_o = coll_q;
-  assign cfg_bit_o       = cfg_c[NumChips];
+  assign cfg_bit_o       = chain_c[NumChips].cfg;
   // The last chip's words come out first; within a chip, PE 0's word first.
-  assign obs_bit_o       = obs_c[NumChips];
+  assign obs_bit_o       = chain_c[NumChips].obs;
 endmodule
 
 `default_nettype wire

@@ -1,7 +1,8 @@
 // Difference Engine: one chip of nine x-processors (Kuijk 1995, 7.4.5, Fig. 7.7).
 //
 // Bus:    id/data (skewed blocks) -> PE 0 -> ... -> PE 8 -> boundary register -> out.
-// Pixels: pix_i (from the upstream chip) OR the nine PEs' pixels -> boundary register.
+// Pixels: the upstream chip's pixel OR the nine PEs' pixels -> boundary register.
+// Both travel with the collision flag in one de_pkg::link_t (link_i -> link_o).
 // The boundary registers keep the combinational depth independent of the chip count.
 // Because both buses gain exactly one register per chip, a pixel of column q leaves the
 // last chip at (Refresh entry) + q + NumChips + const for every q: raster order with no
@@ -14,7 +15,7 @@
 // all-zero observation word); relative addressing makes the remaining PEs a smaller
 // array, one clock later per bypassed PE.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
-// (flags, stage-1 identifier, control pipeline) on obs_load_i and shifts them out.
+// (flags, stage-1 identifier, control pipeline) on obs_load and shifts them out.
 `default_nettype none
 
 module de_chip
@@ -27,27 +28,18 @@ module de_chip
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
-  input  logic [IdW-1:0]   id_i,
-  input  logic [DataW-1:0] data_i,
-  output logic [IdW-1:0]   id_o,
-  output logic [DataW-1:0] data_o,
-  input  logic             pix_valid_i,
-  input  logic [PixW-1:0]  pix_i,
-  output logic             pix_valid_o,
-  output logic [PixW-1:0]  pix_o,
-  // configuration chain: shifts one bit per clock while cfg_mode_i
-  input  logic             cfg_mode_i,
-  input  logic             cfg_bit_i,
-  output logic             cfg_bit_o,
-  // observation chain: parallel load on obs_load_i, shift one bit per clock on obs_shift_i
-  input  logic             obs_load_i,
-  input  logic             obs_shift_i,
-  input  logic             obs_bit_i,
-  output logic             obs_bit_o,
-  output logic [NumPe-1:0] bypass_o,    // current configuration, for tests and waves
-  // Two pixels met on the chain this cycle (registered): two Refreshes were closer
-  // than the array is wide, breaking "one Refresh active at a time" (7.4.1).
-  output logic             collision_o
+  // The bus and pixel chain from the upstream chip (its coll is not used: the array ORs
+  // the chips' flags) and to the next, registered. link_o.coll: two pixels met on the
+  // chain this cycle (registered): two Refreshes were closer than the array is wide,
+  // breaking "one Refresh active at a time" (7.4.1).
+  input  link_t            link_i,
+  output link_t            link_o,
+  // configuration chain: shifts one bit per clock while chain_ctl_i.cfg_mode;
+  // observation chain: parallel load on .obs_load, shift one bit per clock on .obs_shift
+  input  chain_ctl_t       chain_ctl_i,
+  input  chain_t           chain_i,
+  output chain_t           chain_o,
+  output logic [NumPe-1:0] bypass_o     // current configuration, for tests and waves
 );
   // Keep the chip a module of its own in Verilator's C++: the 72 instances then share one
   // class instead of flattening 648 PEs into one 90 MB root (build time 11 -> 2 min for 72 chips on 2 cores).
@@ -57,33 +49,14 @@ module de_chip
   // output) followed by the boundary registers. The split lets the fast simulation
   // (sim/fast, docs/simulation.md) cut the array at the registers and compile one chip
   // once; the logic is the same either way.
-  logic [IdW-1:0]   core_id;
-  logic [DataW-1:0] core_data;
-  logic             core_pixv, core_coll;
-  logic [PixW-1:0]  core_pix;
+  link_t core_link;
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .FaultMask(FaultMask)) u_core (
-    .clk_i, .rst_i, .id_i, .data_i, .pix_valid_i, .pix_i,
-    .id_o       (core_id),
-    .data_o     (core_data),
-    .pix_valid_o(core_pixv),
-    .pix_o      (core_pix),
-    .coll_o     (core_coll),
-    .cfg_mode_i, .cfg_bit_i, .cfg_bit_o,
-    .obs_load_i, .obs_shift_i, .obs_bit_i, .obs_bit_o,
-    .bypass_o
+    .clk_i, .rst_i, .link_i, .chain_ctl_i, .chain_i, .chain_o, .bypass_o,
+    .link_o(core_link)
   );
 
-  de_chip_bound u_bound (
-    .clk_i, .rst_i,
-    .id_i       (core_id),
-    .data_i     (core_data),
-    .pix_valid_i(core_pixv),
-    .pix_i      (core_pix),
-    .coll_i     (core_coll),
-    .id_o, .data_o, .pix_valid_o, .pix_o,
-    .coll_o     (collision_o)
-  );
+  de_chip_bound u_bound (.clk_i, .rst_i, .link_i(core_link), .link_o);
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
@@ -100,22 +73,14 @@ module de_chip_core
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
-  input  logic [IdW-1:0]   id_i,
-  input  logic [DataW-1:0] data_i,
-  output logic [IdW-1:0]   id_o,         // combinational: the last PE's bus (or bypass)
-  output logic [DataW-1:0] data_o,
-  input  logic             pix_valid_i,
-  input  logic [PixW-1:0]  pix_i,
-  output logic             pix_valid_o,  // combinational: pix_i OR the PEs' pixels
-  output logic [PixW-1:0]  pix_o,
-  output logic             coll_o,       // combinational: two pixels met in this chip
-  input  logic             cfg_mode_i,
-  input  logic             cfg_bit_i,
-  output logic             cfg_bit_o,
-  input  logic             obs_load_i,
-  input  logic             obs_shift_i,
-  input  logic             obs_bit_i,
-  output logic             obs_bit_o,
+  /* verilator lint_off UNUSEDSIGNAL */
+  input  link_t            link_i,       // .coll not used
+  /* verilator lint_on UNUSEDSIGNAL */
+  output link_t            link_o,       // combinational: the last PE's bus (or bypass),
+                                         // its pixel OR the PEs' pixels, two pixels met here
+  input  chain_ctl_t       chain_ctl_i,
+  input  chain_t           chain_i,
+  output chain_t           chain_o,
   output logic [NumPe-1:0] bypass_o
 );
   // Observation word per PE: {pA,pB,pC,dis,lock,acc_mode,act,id1} and the 12 control
@@ -137,10 +102,10 @@ module de_chip_core
   logic [NumPe-1:0]          byp_d, byp_q;
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
-  assign bus_id[0]   = id_i;
-  assign bus_data[0] = data_i;
-  assign pix_or[0]   = pix_valid_i ? pix_i : '0;
-  assign pixv_or[0]  = pix_valid_i;
+  assign bus_id[0]   = link_i.id;
+  assign bus_data[0] = link_i.data;
+  assign pix_or[0]   = link_i.pix_valid ? link_i.pix : '0;
+  assign pixv_or[0]  = link_i.pix_valid;
 
   for (genvar i = 0; i < NumPe; i++) begin : g_pe
     logic [IdW-1:0]   pe_id;
@@ -206,21 +171,21 @@ module de_chip_core
   // Configuration shift register: enters at PE 0, leaves after PE NumPe-1.
   // {byp_q, cfg_bit_i} shifted by one; its top bit is the one leaving (cfg_bit_o).
   logic [NumPe:0] byp_shifted;
-  assign byp_shifted = {byp_q, cfg_bit_i};
+  assign byp_shifted = {byp_q, chain_i.cfg};
   always_comb begin
     byp_d = byp_q;
-    if (cfg_mode_i) byp_d = byp_shifted[NumPe-1:0];
+    if (chain_ctl_i.cfg_mode) byp_d = byp_shifted[NumPe-1:0];
   end
-  assign cfg_bit_o = byp_shifted[NumPe];
+  assign chain_o.cfg = byp_shifted[NumPe];
   assign bypass_o  = byp_q;
 
   // Observation shift register: PE 0's word shifts out first, LSB first.
   always_comb begin
     obs_d = obs_q;
-    if (obs_load_i) obs_d = obs_load;
-    else if (obs_shift_i) obs_d = {obs_bit_i, obs_q[NumPe*ObsW-1:1]};
+    if (chain_ctl_i.obs_load) obs_d = obs_load;
+    else if (chain_ctl_i.obs_shift) obs_d = {chain_i.obs, obs_q[NumPe*ObsW-1:1]};
   end
-  assign obs_bit_o = obs_q[0];
+  assign chain_o.obs = obs_q[0];
 
   // Configuration and observation registers.
   always_ff @(posedge clk_i) begin
@@ -233,11 +198,7 @@ module de_chip_core
     end
   end
 
-  assign id_o        = bus_id[NumPe];
-  assign data_o      = bus_data[NumPe];
-  assign pix_valid_o = pixv_or[NumPe];
-  assign pix_o       = pix_or[NumPe];
-  assign coll_o      = |coll;
+  assign link_o = {bus_id[NumPe], bus_data[NumPe], pixv_or[NumPe], pix_or[NumPe], |coll};
 
 endmodule
 
@@ -246,19 +207,12 @@ endmodule
 module de_chip_bound
   import de_pkg::*;
 (
-  input  logic             clk_i,
-  input  logic             rst_i,
-  input  logic [IdW-1:0]   id_i,
-  input  logic [DataW-1:0] data_i,
-  input  logic             pix_valid_i,
-  input  logic [PixW-1:0]  pix_i,
-  input  logic             coll_i,
-  output logic [IdW-1:0]   id_o,
-  output logic [DataW-1:0] data_o,
-  output logic             pix_valid_o,
-  output logic [PixW-1:0]  pix_o,
-  output logic             coll_o
+  input  logic  clk_i,
+  input  logic  rst_i,
+  input  link_t link_i,
+  output link_t link_o
 );
+  // One register per field, named as the trace harness binds them (sim/harness).
   logic [IdW-1:0]   id_q;
   logic [DataW-1:0] data_q;
   logic             pixv_q;
@@ -266,26 +220,11 @@ module de_chip_bound
   logic             coll_q;
 
   always_ff @(posedge clk_i) begin
-    if (rst_i) begin
-      id_q   <= '0;
-      data_q <= '0;
-      pixv_q <= 1'b0;
-      pix_q  <= '0;
-      coll_q <= 1'b0;
-    end else begin
-      id_q   <= id_i;
-      data_q <= data_i;
-      pixv_q <= pix_valid_i;
-      pix_q  <= pix_i;
-      coll_q <= coll_i;
-    end
+    if (rst_i) {id_q, data_q, pixv_q, pix_q, coll_q} <= '0;
+    else       {id_q, data_q, pixv_q, pix_q, coll_q} <= link_i;
   end
 
-  assign id_o        = id_q;
-  assign data_o      = data_q;
-  assign pix_valid_o = pixv_q;
-  assign pix_o       = pix_q;
-  assign coll_o      = coll_q;
+  assign link_o = {id_q, data_q, pixv_q, pix_q, coll_q};
 endmodule
 
 `default_nettype wire

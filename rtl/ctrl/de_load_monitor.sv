@@ -59,15 +59,17 @@ module de_load_monitor #(
   // ---------------------------------------------------------------------------------
   // Current line window.
   logic [11:0] ln_issued_d, ln_issued_q, ln_free_d, ln_free_q;
-  // Live frame accumulators and their snapshot.
-  logic [31:0] fr_issued_d, fr_issued_q, fr_free_d, fr_free_q, fr_drop_d, fr_drop_q;
-  logic [15:0] fr_late_d, fr_late_q;
-  logic [11:0] fr_max_d, fr_max_q;
-  logic [NumBins-1:0][15:0] hist_d, hist_q;
-  logic [31:0] sn_issued_d, sn_issued_q, sn_free_d, sn_free_q, sn_drop_d, sn_drop_q;
-  logic [15:0] sn_late_d, sn_late_q;
-  logic [11:0] sn_max_d, sn_max_q;
-  logic [NumBins-1:0][15:0] sn_hist_d, sn_hist_q;
+  // A frame's statistics: accumulated live (fr_) and published at its last line (sn_,
+  // what the host reads).
+  typedef struct packed {
+    logic [31:0]              issued;
+    logic [31:0]              free;
+    logic [31:0]              drop;
+    logic [15:0]              late;   // late lines
+    logic [11:0]              max;    // most instructions in one line
+    logic [NumBins-1:0][15:0] hist;   // lines per bin of instructions per line
+  } frame_stats_t;
+  frame_stats_t fr_d, fr_q, sn_d, sn_q;
   // Cumulative.
   logic [31:0] frames_d, frames_q, tot_drop_d, tot_drop_q, tot_late_d, tot_late_q;
   logic [11:0] last_line_d, last_line_q;
@@ -92,18 +94,9 @@ module de_load_monitor #(
   always_comb begin
     ln_issued_d = ln_issued_q + 12'(ev_issue_i);
     ln_free_d   = ln_free_q + 12'(ev_free_i);
-    fr_issued_d = fr_issued_q;
-    fr_free_d   = fr_free_q;
-    fr_late_d   = fr_late_q;
-    fr_max_d    = fr_max_q;
-    hist_d      = hist_q;
-    fr_drop_d   = fr_drop_q + 32'(n_drop);
-    sn_issued_d = sn_issued_q;
-    sn_free_d   = sn_free_q;
-    sn_drop_d   = sn_drop_q;
-    sn_late_d   = sn_late_q;
-    sn_max_d    = sn_max_q;
-    sn_hist_d   = sn_hist_q;
+    fr_d        = fr_q;
+    fr_d.drop   = fr_q.drop + 32'(n_drop);
+    sn_d        = sn_q;
     frames_d    = frames_q;
     tot_drop_d  = tot_drop_q + 32'(n_drop);
     tot_late_d  = tot_late_q;
@@ -115,30 +108,20 @@ module de_load_monitor #(
       ln_free_d   = '0;
     end
     if (rec_we) begin
-      fr_issued_d = fr_issued_q + 32'(ln_issued_q);
-      fr_free_d   = fr_free_q + 32'(ln_free_q);
-      fr_late_d   = fr_late_q + 16'(line_late);
-      tot_late_d  = tot_late_q + 32'(line_late);
-      fr_max_d    = (ln_issued_q > fr_max_q) ? ln_issued_q : fr_max_q;
-      hist_d[bin] = hist_q[bin] + 16'd1;
+      fr_d.issued    = fr_q.issued + 32'(ln_issued_q);
+      fr_d.free      = fr_q.free + 32'(ln_free_q);
+      fr_d.late      = fr_q.late + 16'(line_late);
+      tot_late_d     = tot_late_q + 32'(line_late);
+      fr_d.max       = (ln_issued_q > fr_q.max) ? ln_issued_q : fr_q.max;
+      fr_d.hist[bin] = fr_q.hist[bin] + 16'd1;
       last_line_d = ev_line_i;
       last_rec_d  = rec;
     end
     if (ev_last_line_i) begin
       // Frame done: publish everything including this line and this cycle's discards.
-      sn_issued_d = fr_issued_d;
-      sn_free_d   = fr_free_d;
-      sn_drop_d   = fr_drop_d;
-      sn_late_d   = fr_late_d;
-      sn_max_d    = fr_max_d;
-      sn_hist_d   = hist_d;
-      frames_d    = frames_q + 32'd1;
-      fr_issued_d = '0;
-      fr_free_d   = '0;
-      fr_drop_d   = '0;
-      fr_late_d   = '0;
-      fr_max_d    = '0;
-      hist_d      = '0;
+      sn_d     = fr_d;
+      frames_d = frames_q + 32'd1;
+      fr_d     = '0;
     end
   end
 
@@ -146,18 +129,8 @@ module de_load_monitor #(
     if (rst_i) begin
       ln_issued_q <= '0;
       ln_free_q   <= '0;
-      fr_issued_q <= '0;
-      fr_free_q   <= '0;
-      fr_drop_q   <= '0;
-      fr_late_q   <= '0;
-      fr_max_q    <= '0;
-      hist_q      <= '0;
-      sn_issued_q <= '0;
-      sn_free_q   <= '0;
-      sn_drop_q   <= '0;
-      sn_late_q   <= '0;
-      sn_max_q    <= '0;
-      sn_hist_q   <= '0;
+      fr_q        <= '0;
+      sn_q        <= '0;
       frames_q    <= '0;
       tot_drop_q  <= '0;
       tot_late_q  <= '0;
@@ -166,18 +139,8 @@ module de_load_monitor #(
     end else begin
       ln_issued_q <= ln_issued_d;
       ln_free_q   <= ln_free_d;
-      fr_issued_q <= fr_issued_d;
-      fr_free_q   <= fr_free_d;
-      fr_drop_q   <= fr_drop_d;
-      fr_late_q   <= fr_late_d;
-      fr_max_q    <= fr_max_d;
-      hist_q      <= hist_d;
-      sn_issued_q <= sn_issued_d;
-      sn_free_q   <= sn_free_d;
-      sn_drop_q   <= sn_drop_d;
-      sn_late_q   <= sn_late_d;
-      sn_max_q    <= sn_max_d;
-      sn_hist_q   <= sn_hist_d;
+      fr_q        <= fr_d;
+      sn_q        <= sn_d;
       frames_q    <= frames_d;
       tot_drop_q  <= tot_drop_d;
       tot_late_q  <= tot_late_d;
@@ -215,17 +178,17 @@ module de_load_monitor #(
     if (reg_addr_i[11:10] == de_pkg::LmLineBase[11:10]) begin
       sel_line_d = (32'(reg_addr_i[9:0]) < MaxLines);
     end else if (reg_addr_i[11:6] == de_pkg::LmHistBase[11:6]) begin
-      if (32'(reg_addr_i[5:0]) < NumBins) rdata_d = {16'h0, sn_hist_q[reg_addr_i[5:0]]};
+      if (32'(reg_addr_i[5:0]) < NumBins) rdata_d = {16'h0, sn_q.hist[reg_addr_i[5:0]]};
     end else begin
       unique case (reg_addr_i)
         de_pkg::LmRegId:        rdata_d = {de_pkg::LmIdMagic, 8'(NumBins), 4'(BinShift), 4'(NumBuf),
                                            8'h01};
         de_pkg::LmRegFrames:    rdata_d = frames_q;
-        de_pkg::LmRegIssued:    rdata_d = sn_issued_q;
-        de_pkg::LmRegFree:      rdata_d = sn_free_q;
-        de_pkg::LmRegLate:      rdata_d = {16'h0, sn_late_q};
-        de_pkg::LmRegDrop:      rdata_d = sn_drop_q;
-        de_pkg::LmRegMaxIssued: rdata_d = {20'h0, sn_max_q};
+        de_pkg::LmRegIssued:    rdata_d = sn_q.issued;
+        de_pkg::LmRegFree:      rdata_d = sn_q.free;
+        de_pkg::LmRegLate:      rdata_d = {16'h0, sn_q.late};
+        de_pkg::LmRegDrop:      rdata_d = sn_q.drop;
+        de_pkg::LmRegMaxIssued: rdata_d = {20'h0, sn_q.max};
         de_pkg::LmRegLastLine:  rdata_d = {20'h0, last_line_q};
         de_pkg::LmRegLastRec:   rdata_d = last_rec_q;
         de_pkg::LmRegTotalDrop: rdata_d = tot_drop_q;

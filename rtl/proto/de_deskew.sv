@@ -3,15 +3,15 @@
 // words again. Block 0 (and the identifier) wait two cycles, block 1 one cycle.
 `default_nettype none
 
-module de_deskew (
-  input  logic        clk_i,
-  input  logic        rst_i,
-  input  logic [11:0] id_i,
-  input  logic [11:0] blk0_i,
-  input  logic [11:0] blk1_i,
-  input  logic [11:0] blk2_i,
-  output logic [11:0] id_o,
-  output logic [35:0] data_o
+module de_deskew
+  import de_pkg::*;
+(
+  input  logic                         clk_i,
+  input  logic                         rst_i,
+  input  logic [IdW-1:0]               id_i,
+  input  logic [NumBlk-1:0][BlkW-1:0]  blk_i,   // block j j clocks late (de_skew's)
+  output logic [IdW-1:0]               id_o,
+  output logic [DataW-1:0]             data_o
 );
   logic [11:0] ident_q, ident_q2, blk0_q, blk0_q2, blk1_q;
 
@@ -25,14 +25,14 @@ module de_deskew (
     end else begin
       ident_q  <= id_i;
       ident_q2 <= ident_q;
-      blk0_q   <= blk0_i;
+      blk0_q   <= blk_i[0];
       blk0_q2  <= blk0_q;
-      blk1_q   <= blk1_i;
+      blk1_q   <= blk_i[1];
     end
   end
 
   assign id_o    = ident_q2;
-  assign data_o  = {blk2_i, blk1_q, blk0_q2};
+  assign data_o  = {blk_i[2], blk1_q, blk0_q2};
 endmodule
 
 `default_nettype wire

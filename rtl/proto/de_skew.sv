@@ -4,15 +4,15 @@
 // clock cycles; the identifier travels with block 0.
 `default_nettype none
 
-module de_skew (
-  input  logic        clk_i,
-  input  logic        rst_i,
-  input  logic [11:0] id_i,
-  input  logic [35:0] data_i,
-  output logic [11:0] id_o,
-  output logic [11:0] blk0_o,
-  output logic [11:0] blk1_o,
-  output logic [11:0] blk2_o
+module de_skew
+  import de_pkg::*;
+(
+  input  logic                         clk_i,
+  input  logic                         rst_i,
+  input  logic [IdW-1:0]               id_i,
+  input  logic [DataW-1:0]             data_i,
+  output logic [IdW-1:0]               id_o,
+  output logic [NumBlk-1:0][BlkW-1:0]  blk_o    // block j delayed by j clocks
 );
   logic [11:0] blk1_q, blk2_q, blk2_q2;
 
@@ -28,10 +28,8 @@ module de_skew (
     end
   end
 
-  assign id_o    = id_i;
-  assign blk0_o  = data_i[11:0];
-  assign blk1_o  = blk1_q;
-  assign blk2_o  = blk2_q2;
+  assign id_o  = id_i;
+  assign blk_o = {blk2_q2, blk1_q, data_i[11:0]};
 endmodule
 
 `default_nettype wire

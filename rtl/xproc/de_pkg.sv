@@ -47,6 +47,31 @@ package de_pkg;
     logic [1:0] sub;
   } id_t;
 
+  // ---- the array's chain from chip to chip (rtl/array/de_chip.sv) ----
+  // What a chip passes to the next: the bus (skewed blocks), the pixel chain and the
+  // chip's collision flag (MSB first). de_chip, its core and boundary registers and the
+  // fast array's pieces (sim/fast) all pass this one value; a chip does not use the
+  // coll of its input (the array ORs the chips' flags).
+  typedef struct packed {
+    logic [IdW-1:0]   id;
+    logic [DataW-1:0] data;
+    logic             pix_valid;
+    logic [PixW-1:0]  pix;
+    logic             coll;
+  } link_t;
+  // The configuration and observation chains: one serial bit each, chip to chip ...
+  typedef struct packed {
+    logic cfg;
+    logic obs;
+  } chain_t;
+  // ... and their controls, the same for every chip: shift the configuration, load
+  // and shift the observation words (7.4.5).
+  typedef struct packed {
+    logic cfg_mode;
+    logic obs_load;
+    logic obs_shift;
+  } chain_ctl_t;
+
   // Register codes of the DST / SRC fields; RegNone reads as zero.
   localparam logic [1:0] RegNone = 2'd0;
   localparam logic [1:0] RegA = 2'd1;

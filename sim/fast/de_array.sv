@@ -52,29 +52,18 @@ module de_array
   longint      s_data;
   /* verilator lint_on UNUSEDSIGNAL */
   bit          s_pixv, s_coll, s_cfg, s_obs;
-  logic [IdW-1:0]   id_q;
-  logic [DataW-1:0] data_q;
-  logic             pixv_q, coll_q, cfg_q, obs_q;
-  logic [PixW-1:0]  pix_q;
 
+  // Every output of de_array is a register: the model's answer, taken at the edge.
   always @(posedge clk_i) begin
     de_fast_step(h, rst_i, 32'(id_i), 64'(data_i), cfg_mode_i, cfg_bit_i, obs_load_i,
                  obs_shift_i, s_id, s_data, s_pixv, s_pix, s_coll, s_cfg, s_obs);
-    id_q   <= IdW'(s_id);
-    data_q <= DataW'(s_data);
-    pixv_q <= s_pixv;
-    pix_q  <= PixW'(s_pix);
-    coll_q <= s_coll;
-    cfg_q  <= s_cfg;
-    obs_q  <= s_obs;
+    id_o            <= IdW'(s_id);
+    data_o          <= DataW'(s_data);
+    pix_valid_o     <= s_pixv;
+    pix_o           <= PixW'(s_pix);
+    pix_collision_o <= s_coll;
+    cfg_bit_o       <= s_cfg;
+    obs_bit_o       <= s_obs;
   end
-
-  assign id_o            = id_q;
-  assign data_o          = data_q;
-  assign pix_valid_o     = pixv_q;
-  assign pix_o           = pix_q;
-  assign n_pe_o          = 16'(NumChips * NumPe);
-  assign pix_collision_o = coll_q;
-  assign cfg_bit_o       = cfg_q;
-  assign obs_bit_o       = obs_q;
+  assign n_pe_o = 16'(NumChips * NumPe);
 endmodule

@@ -100,14 +100,11 @@ Array::~Array() {
 
 
 namespace {
-// A piece takes its upstream neighbour's chip-core outputs (bus, pixel chain, collision).
-template <class Dst, class Src>
-inline void take_bus(Dst& d, const Src& s) {
-  d.id_i = s.id_o;
-  d.data_i = s.data_o;
-  d.pix_valid_i = s.pix_valid_o;
-  d.pix_i = s.pix_o;
-  d.coll_i = s.coll_o;
+// de_pkg::chain_t = {cfg, obs} and chain_ctl_t = {cfg_mode, obs_load, obs_shift}, packed
+// MSB first as Verilator passes them (sim/fast/equiv.cpp checks the chains' outputs).
+constexpr unsigned kChainCfg = 1u << 1, kChainObs = 1u << 0;
+inline uint8_t chain_ctl(const In& in) {
+  return static_cast<uint8_t>((in.cfg_mode << 2) | (in.obs_load << 1) | in.obs_shift);
 }
 }  // namespace
 
@@ -118,32 +115,23 @@ Out Array::step(const In& in) {
   eval(h);
 
   // 2. Tail first, then the units from the last to the first: each piece reads its
-  //    upstream neighbour before that neighbour's edge.
+  //    upstream neighbour's de_pkg::link_t (bus, pixel chain, collision) before that
+  //    neighbour's edge.
   Vde_fast_tail& t = *tail_;
   bool coll_others = false;
   for (auto& u : units_) coll_others |= u->prev_coll_o;
   t.rst_i = in.rst;
   t.coll_others_i = coll_others;
-  if (units_.empty()) take_bus(t, h);
-  else take_bus(t, *units_.back());
+  t.link_i = units_.empty() ? h.link_o : units_.back()->link_o;
   edge(t);
 
+  const uint8_t ctl = chain_ctl(in);
   for (size_t k = units_.size(); k-- > 0;) {
     Vde_fast_unit& u = *units_[k];
     u.rst_i = in.rst;
-    u.cfg_mode_i = in.cfg_mode;
-    u.obs_load_i = in.obs_load;
-    u.obs_shift_i = in.obs_shift;
-    if (k == 0) {
-      take_bus(u, h);
-      u.cfg_bit_i = h.cfg_bit_o;
-      u.obs_bit_i = h.obs_bit_o;
-    } else {
-      const Vde_fast_unit& p = *units_[k - 1];
-      take_bus(u, p);
-      u.cfg_bit_i = p.cfg_bit_o;
-      u.obs_bit_i = p.obs_bit_o;
-    }
+    u.chain_ctl_i = ctl;
+    u.link_i = k == 0 ? h.link_o : units_[k - 1]->link_o;
+    u.chain_i = k == 0 ? h.chain_o : units_[k - 1]->chain_o;
     edge(u);
   }
 
@@ -156,13 +144,9 @@ Out Array::step(const In& in) {
   o.pixel_valid = t.pix_valid_o;
   o.pixel = t.pix_o;
   o.collision = t.pix_collision_o;
-  if (units_.empty()) {
-    o.cfg_bit = h.cfg_bit_o;
-    o.obs_bit = h.obs_bit_o;
-  } else {
-    o.cfg_bit = units_.back()->cfg_bit_o;
-    o.obs_bit = units_.back()->obs_bit_o;
-  }
+  const uint8_t chain = units_.empty() ? h.chain_o : units_.back()->chain_o;
+  o.cfg_bit = (chain & kChainCfg) != 0;
+  o.obs_bit = (chain & kChainObs) != 0;
   return o;
 }
 

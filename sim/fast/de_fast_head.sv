@@ -8,43 +8,32 @@ module de_fast_head
   parameter int unsigned NumPe    = 9,
   parameter int unsigned CarryBug = 0
 ) (
+  // de_array's inputs, as de_sim::drive (sim/include/de_verilated.h) names them
   input  logic             clk_i,
   input  logic             rst_i,
   input  logic [IdW-1:0]   id_i,
   input  logic [DataW-1:0] data_i,
-  output logic [IdW-1:0]   id_o,
-  output logic [DataW-1:0] data_o,
-  output logic             pix_valid_o,
-  output logic [PixW-1:0]  pix_o,
-  output logic             coll_o,
   input  logic             cfg_mode_i,
   input  logic             cfg_bit_i,
-  output logic             cfg_bit_o,
   input  logic             obs_load_i,
   input  logic             obs_shift_i,
-  output logic             obs_bit_o
+  // chip 0's core outputs
+  output link_t            link_o,
+  output chain_t           chain_o
 );
-  logic [11:0] skew_id, skew_b0, skew_b1, skew_b2;
+  link_t skew_link;  // chip 0's input: the skewed bus, no pixel
   /* verilator lint_off UNUSEDSIGNAL */
   logic [NumPe-1:0] bypass;
   /* verilator lint_on UNUSEDSIGNAL */
 
-  de_skew u_skew (
-    .clk_i, .rst_i, .id_i, .data_i,
-    .id_o(skew_id), .blk0_o(skew_b0), .blk1_o(skew_b1), .blk2_o(skew_b2)
-  );
+  de_skew u_skew (.clk_i, .rst_i, .id_i, .data_i, .id_o(skew_link.id), .blk_o(skew_link.data));
+  assign {skew_link.pix_valid, skew_link.pix, skew_link.coll} = '0;
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug)) u_core (
-    .clk_i, .rst_i,
-    .id_i       (skew_id),
-    .data_i     ({skew_b2, skew_b1, skew_b0}),
-    .pix_valid_i(1'b0),
-    .pix_i      ('0),
-    .id_o, .data_o, .pix_valid_o, .pix_o, .coll_o,
-    .cfg_mode_i, .cfg_bit_i, .cfg_bit_o,
-    .obs_load_i, .obs_shift_i,
-    .obs_bit_i  (1'b0),
-    .obs_bit_o,
+    .clk_i, .rst_i, .link_o, .chain_o,
+    .link_i     (skew_link),
+    .chain_ctl_i({cfg_mode_i, obs_load_i, obs_shift_i}),
+    .chain_i    ({cfg_bit_i, 1'b0}),
     .bypass_o   (bypass)
   );
 endmodule

@@ -10,51 +10,26 @@ module de_fast_unit
   parameter int unsigned NumPe    = 9,
   parameter int unsigned CarryBug = 0
 ) (
-  input  logic             clk_i,
-  input  logic             rst_i,
-  // chip c-1's core outputs (combinational there), registered here
-  input  logic [IdW-1:0]   id_i,
-  input  logic [DataW-1:0] data_i,
-  input  logic             pix_valid_i,
-  input  logic [PixW-1:0]  pix_i,
-  input  logic             coll_i,
-  // chip c's core outputs
-  output logic [IdW-1:0]   id_o,
-  output logic [DataW-1:0] data_o,
-  output logic             pix_valid_o,
-  output logic [PixW-1:0]  pix_o,
-  output logic             coll_o,
-  output logic             prev_coll_o,  // chip c-1's collision_o (its boundary register)
-  input  logic             cfg_mode_i,
-  input  logic             cfg_bit_i,
-  output logic             cfg_bit_o,
-  input  logic             obs_load_i,
-  input  logic             obs_shift_i,
-  input  logic             obs_bit_i,
-  output logic             obs_bit_o
+  input  logic       clk_i,
+  input  logic       rst_i,
+  input  link_t      link_i,       // chip c-1's core outputs (combinational there), registered here
+  output link_t      link_o,       // chip c's core outputs
+  output logic       prev_coll_o,  // chip c-1's collision flag (its boundary register)
+  input  chain_ctl_t chain_ctl_i,
+  input  chain_t     chain_i,
+  output chain_t     chain_o
 );
-  logic [IdW-1:0]   b_id;
-  logic [DataW-1:0] b_data;
-  logic             b_pixv;
-  logic [PixW-1:0]  b_pix;
+  link_t b_link;
   /* verilator lint_off UNUSEDSIGNAL */
   logic [NumPe-1:0] bypass;
   /* verilator lint_on UNUSEDSIGNAL */
 
-  de_chip_bound u_bound (
-    .clk_i, .rst_i, .id_i, .data_i, .pix_valid_i, .pix_i, .coll_i,
-    .id_o(b_id), .data_o(b_data), .pix_valid_o(b_pixv), .pix_o(b_pix), .coll_o(prev_coll_o)
-  );
+  de_chip_bound u_bound (.clk_i, .rst_i, .link_i, .link_o(b_link));
+  assign prev_coll_o = b_link.coll;
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug)) u_core (
-    .clk_i, .rst_i,
-    .id_i       (b_id),
-    .data_i     (b_data),
-    .pix_valid_i(b_pixv),
-    .pix_i      (b_pix),
-    .id_o, .data_o, .pix_valid_o, .pix_o, .coll_o,
-    .cfg_mode_i, .cfg_bit_i, .cfg_bit_o,
-    .obs_load_i, .obs_shift_i, .obs_bit_i, .obs_bit_o,
+    .clk_i, .rst_i, .link_o, .chain_ctl_i, .chain_i, .chain_o,
+    .link_i     (b_link),
     .bypass_o   (bypass)
   );
 endmodule

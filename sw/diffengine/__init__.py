@@ -18,8 +18,15 @@ says what belongs there):
 
 The package imports nothing from cocotb, so the model can be used and tested alone.
 """
+import sys
 from pathlib import Path
 
 __version__ = "0.1.0"
 
 REPO = Path(__file__).resolve().parents[2]   # the checkout: sw/diffengine/__init__.py
+
+
+def fail(prog: str, msg, status: int = 1) -> int:
+    """Every command's error line, `PROG: error: MSG` on stderr; returns the exit status."""
+    print(f"{prog}: error: {msg}", file=sys.stderr)
+    return status

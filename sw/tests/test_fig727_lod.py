@@ -86,6 +86,58 @@ def test_fig727_rtl_plays_the_frames_like_the_golden_model(played):
         np.testing.assert_array_equal(frames[f], gold[f], err_msg=f"frame {f}")
 
 
+# Temporally coherent fitting (docs/yproc.md section 11): a slow light (legs of 512
+# frames) at tolerance 4, where the previous frame's colour functions mostly still hold.
+COH_TOL = 4
+
+
+@pytest.fixture(scope="module")
+def coherent(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("fig727coh")
+    slow = anim.anim_variant(_anim(tmp), tmp / "fig7_27_slow.anim", FRAMES, leg=512)
+    assert "wander 0 2718 512 " in slow.read_text() and f"frames {FRAMES}" in slow.read_text()
+    st = {}
+    for name, flags in (("coh", ("--coherent",)), ("plain", ())):
+        st[name] = _yproc(slow, tmp / name, "--full", "--expect", "--cmd", "--tol", COH_TOL, *flags)
+    return tmp, st, anim.frames(tmp / "coh")
+
+
+def test_coherent_frames_within_tolerance_and_fewer_changes(coherent):
+    tmp, st, seq = coherent
+    assert st["coh"]["coherent"] == 1 and st["coh"]["frames_differing_from_full"] == 0
+    # frame 0 plus the deltas equals every frame's full re-render from the same previous
+    # frame (word for word)
+    for f in range(FRAMES):
+        full = [anim.lines_of_de48(tmp / "coh" / f"frame{f:03d}" / f"{c}.de48") for c in "rgb"]
+        assert seq[f] == full, f"frame {f}: deltas applied != full re-render"
+    # the error bound holds against the exact shading in every frame (the golden model,
+    # not yproc's own array model): 1/2 + the three terms' tolerance (base, texture,
+    # specular; partly covered pixels at 1/64)
+    bound = 0.5 + 3 * COH_TOL + 0.05
+    for f in range(FRAMES):
+        ideal = np.fromfile(tmp / "coh" / f"frame{f:03d}" / "ideal.f64", dtype="<f8").reshape(3, H, W)
+        err = float(np.abs(anim.golden_frame(seq[f], W).transpose(2, 0, 1) - ideal).max())
+        assert err <= bound, f"frame {f}: worst pixel {err:.3f} > {bound}"
+        assert abs(err - st["coh"]["frame"][f]["max_abs_err"]) < 1e-3
+    # fewer changed instructions than refitting every frame at the same tolerance
+    coh, plain = (np.array([f["changed_slots"] for f in st[k]["frame"][1:]]).sum() for k in ("coh", "plain"))
+    assert 0 < coh < 0.8 * plain, (coh, plain)
+
+
+def test_coherent_frames_play_on_the_rtl_like_the_golden_model(coherent):
+    tmp, st, seq = coherent
+    # the streams carry what only coherent fitting emits: resyncs onto an old spline
+    # (SetI and SetdI inside an Eval3's span) and the edge pixels' own Eval1
+    text = "".join((tmp / "coh" / f"frame{f:03d}" / f"{c}.cmd").read_text() for f in range(1, FRAMES) for c in "rgb")
+    assert text.count("SetI (") > 20 and text.count("SetdI (") > 20 and ", 1, 0x" in text
+    gold = [anim.golden_frame(fr, W) for fr in seq]
+    assert not (gold[0] == gold[-1]).all()            # the light really moved
+    frames, rst = anim.play_rtl(seq, W, H, CHIPS, tmp)
+    assert rst["load_monitor"]["R"]["total_late_lines"] == 0
+    for f in range(FRAMES):
+        np.testing.assert_array_equal(frames[f], gold[f], err_msg=f"frame {f}")
+
+
 def test_load_monitor_model_equals_rtl_and_loop_ends_overflow(tmp_path):
     a = _anim(tmp_path, frames=4)
     cap = pipeline.capacity(3, SHORT)

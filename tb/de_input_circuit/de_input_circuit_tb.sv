@@ -11,9 +11,7 @@ module de_input_circuit_tb (
   output logic [11:0] id_o,
   output logic [35:0] data_o,
   output logic [11:0] skew_ident_o,
-  output logic [11:0] skew_blk0_o,
-  output logic [11:0] skew_blk1_o,
-  output logic [11:0] skew_blk2_o,
+  output logic [35:0] skew_blk_o,      // {block 2, block 1, block 0}, skewed
   output logic [11:0] deskew_ident_o,
   output logic [35:0] deskew_data_o
 );
@@ -22,13 +20,10 @@ module de_input_circuit_tb (
     .valid_o, .id_o, .data_o
   );
   de_skew u_skew (
-    .clk_i, .rst_i, .id_i(id_o), .data_i(data_o),
-    .id_o  (skew_ident_o), .blk0_o(skew_blk0_o), .blk1_o(skew_blk1_o),
-    .blk2_o(skew_blk2_o)
+    .clk_i, .rst_i, .id_i(id_o), .data_i(data_o), .id_o(skew_ident_o), .blk_o(skew_blk_o)
   );
   de_deskew u_deskew (
-    .clk_i, .rst_i, .id_i(skew_ident_o), .blk0_i(skew_blk0_o),
-    .blk1_i(skew_blk1_o), .blk2_i(skew_blk2_o),
+    .clk_i, .rst_i, .id_i(skew_ident_o), .blk_i(skew_blk_o),
     .id_o  (deskew_ident_o), .data_o(deskew_data_o)
   );
 endmodule

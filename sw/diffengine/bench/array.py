@@ -166,9 +166,7 @@ def configure(ap) -> None:
                     help="alternating runs of each harness; the median counts")
     ap.add_argument("--no-baseline", action="store_true", help="skip the baseline revision")
     ap.add_argument("--stream-cycles", type=int, default=100_000)
-    ap.add_argument("--write", action="store_true",
-                    help="keep the record in docs/bench and render the 'Verilated array "
-                    "speed' section of docs/performance.md")
+    record.add_write(ap, "the 'Verilated array speed' section of docs/performance.md")
     ap.set_defaults(func=command)
 
 

@@ -187,7 +187,7 @@ def cpu_name():
 
 def configure(ap) -> None:
     """The arguments of this subcommand (the `diffengine` tree calls this)."""
-    ap.add_argument("--write", action="store_true", help="keep the record in docs/bench, render docs/performance.md, docs/img/hsr_*.png")
+    record.add_write(ap, "docs/performance.md, docs/img/hsr_*.png")
     ap.add_argument("--quick", action="store_true", help="smaller sizes (a smoke run)")
     ap.add_argument("--teapot-n", type=int, default=25, help="teapot tessellation (25: 39800 triangles)")
     ap.add_argument("--seed", type=int, default=1995)

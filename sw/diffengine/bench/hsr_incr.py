@@ -174,8 +174,7 @@ def configure(ap) -> None:
                     help="also measure this git revision (e.g. main), alternately with this tree")
     ap.add_argument("--repeat", type=int, default=3, help="runs per figure and binary (min taken)")
     ap.add_argument("--quick", action="store_true", help="parts up to 1,000, the small teapot, one anim run")
-    ap.add_argument("--write", action="store_true",
-                    help="keep the record in docs/bench and render docs/performance.md")
+    record.add_write(ap)
     ap.set_defaults(func=command)
 
 

@@ -122,8 +122,7 @@ def configure(ap) -> None:
     """The arguments of `diffengine bench link`."""
     ap.add_argument("--words", type=int, default=16384, help="words per colour (16384)")
     ap.add_argument("--packet-words", default="24,256", help="packet sizes (24,256)")
-    ap.add_argument("--write", action="store_true",
-                    help="keep the record in docs/bench and update docs/performance.md")
+    record.add_write(ap)
     ap.set_defaults(func=command)
 
 

@@ -4,8 +4,7 @@ from the kept records.
 """
 from __future__ import annotations
 
-import argparse
-import importlib
+from ..cli.tree import add_module_commands
 
 BENCHES = [
     ("model", ".model", "golden model speed (functional and structural)"),
@@ -28,9 +27,5 @@ BENCHES = [
 
 def configure(ap) -> None:
     """The benchmarks, one subcommand each."""
-    sub = ap.add_subparsers(dest="bench", required=True, metavar="NAME")
-    for name, module, help_ in BENCHES:
-        mod = importlib.import_module(module, __package__)
-        mod.configure(sub.add_parser(name, help=help_,
-                                     description=(mod.__doc__ or "").strip().split("\n\n")[0],
-                                     formatter_class=argparse.RawDescriptionHelpFormatter))
+    add_module_commands(ap.add_subparsers(dest="bench", required=True, metavar="NAME"),
+                        BENCHES, __package__)

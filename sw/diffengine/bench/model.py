@@ -178,8 +178,7 @@ def configure(ap) -> None:
     """The arguments of this subcommand (the `diffengine` tree calls this)."""
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--write", action="store_true",
-                    help="keep the record in docs/bench and render docs/performance.md")
+    record.add_write(ap)
     ap.add_argument("--fast", action="store_true",
                     help="the C functional model (sw/fmodel) against the numpy one, on the "
                          "random frames, the teapot and CAD scenes and the animation's "

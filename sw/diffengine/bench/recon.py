@@ -33,6 +33,7 @@ from ..encode import spline as ES
 from ..model.capacity import slots_per_line
 from . import recon_images as RI
 from . import recon_wavelet as RW
+from .record import table_head
 
 # HTotal - 2: the end-of-line marker needs the window's last slot (docs/pipeline.md §1.1)
 PER_LINE = slots_per_line("640x480@60") - 2
@@ -415,8 +416,7 @@ def write_doc(out, names, secs, img_secs):
     a("Same kept coefficients (same lam), four emissions; instructions per frame (per")
     a("channel) and PSNR. `auto` = knots (the cheaper of merged / layered per line).")
     a("")
-    a("| image | code | lam | auto | layered | coefficient | choice |")
-    a("|---|---|---|---|---|---|---|")
+    L.extend(table_head("image", "code", "lam", "auto", "layered", "coefficient", "choice"))
     ratio_c, ratio_ch = [], []
     for n in names:
         emis = out[n][3]
@@ -451,8 +451,8 @@ def write_doc(out, names, secs, img_secs):
     a("are 4:4:4 (no chroma subsampling, like the full-resolution spline channels); with")
     a("OpenImageIO's default 4:2:0 `spheres` stops at 39.1 dB even at quality 100.")
     a("")
-    a("| image | target | spline2 bytes | JPEG q | JPEG bytes | spline2 / JPEG bytes |")
-    a("|---|---|---|---|---|---|")
+    L.extend(table_head("image", "target", "spline2 bytes", "JPEG q", "JPEG bytes",
+                        "spline2 / JPEG bytes"))
     ratios = []
     for n in names:
         jp = out[n][4]
@@ -466,8 +466,8 @@ def write_doc(out, names, secs, img_secs):
                 a(f"| {n} | {tgt:g} dB | {m['spline_bytes']} | {m['q']} | {m['jpeg_bytes']} | "
                   f"{r:.1f} |")
     a("")
-    a("| image | JPEG q=75 bytes | JPEG PSNR | spline2 at those bytes: bytes | PSNR |")
-    a("|---|---|---|---|---|")
+    L.extend(table_head("image", "JPEG q=75 bytes", "JPEG PSNR", "spline2 at those bytes: bytes",
+                        "PSNR"))
     wins = 0
     for n in names:
         m = out[n][4]["bytes"]
@@ -513,8 +513,7 @@ def write_doc(out, names, secs, img_secs):
     a("Fewest instructions per frame (per channel) among the swept points that reach")
     a("the PSNR (lossless point included); bold = best code for that image and target:")
     a("")
-    a("| image | target | spline1 | spline2 | rle | raster |")
-    a("|---|---|---|---|---|---|")
+    L.extend(table_head("image", "target", "spline1", "spline2", "rle", "raster"))
     winners = []
     for n in names:
         rows = out[n][1]
@@ -542,10 +541,7 @@ def write_doc(out, names, secs, img_secs):
     a("  weak point: a rate-distortion knot optimisation (knot removal, dynamic")
     a("  programming per line, SetI value-jump knots for edges) should move the spline")
     a("  curves left. One accumulated Eval per basis function does not help (above).")
-    for n in names:
-        x = out[n][0]
-        if x.shape[1] != 640:
-            continue
+    for n in [n for n in names if out[n][0].shape[1] == 640]:
         cap, rows = out[n][2], out[n][1]
         fit_l = [c for c in ("spline1", "spline2", "rle", "raster") if rows[c][0][4] <= PER_LINE]
         lossy = [f"{c} {fmt_p(cap[c][0])} dB" for c in ("spline1", "spline2")

@@ -24,6 +24,7 @@ from ..encode import spline as ES
 from ..encode import wavelet as WV
 from ..model import functional
 from . import recon_images as RI
+from .record import table_head
 
 WAVELET_BEGIN = "<!-- wavelet section: generated, see sw/diffengine/bench/recon_wavelet.py -->"
 WAVELET_END = "<!-- end of wavelet section -->"
@@ -315,8 +316,7 @@ def section(res: dict, names, per_line: int, img_dir_rel: str = "img") -> list[s
     a("Bytes of the wavelet file over JPEG's at equal PSNR (below 1 = the wavelet file is")
     a("smaller), over the points where JPEG reaches the PSNR:")
     a("")
-    a("| image | min | median | max | points where JPEG is smaller |")
-    a("|---|---|---|---|---|")
+    L.extend(table_head("image", "min", "median", "max", "points where JPEG is smaller"))
     jwin = {}
     for n in names:
         rs = ratios.get(n, [])

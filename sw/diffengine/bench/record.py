@@ -25,6 +25,17 @@ def _plain(o):
     return o.item() if hasattr(o, "item") else str(o)
 
 
+def table_head(*cols: str) -> list[str]:
+    """A Markdown table's header row and rule: table_head("a", "b") -> ["| a | b |", "|---|---|"]."""
+    return ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+
+
+def add_write(ap, renders: str = "docs/performance.md") -> None:
+    """The `--write` flag of every benchmark: keep the record and render what it shows."""
+    ap.add_argument("--write", action="store_true",
+                    help=f"keep the record in docs/bench and render {renders}")
+
+
 def log(name: str, msg: str) -> None:
     print(f"bench {name}: {msg}", file=sys.stderr, flush=True)
 

@@ -16,21 +16,13 @@ from . import record
 
 DOC = REPO / "docs" / "performance.md"
 
-# section -> (module, function) whose function(record) -> the section's markdown
-SECTIONS = {
-    "model": (".model", "render"),
-    "model-fast": (".model", "render_fast"),
-    "hsr": (".hsr", "render"),
-    "hsr-incr": (".hsr_incr", "render"),
-    "table52": (".table52", "render"),
-    "array": (".array", "render"),
-    "yproc": (".yproc", "render"),
-    "yproc-scaling": (".yproc", "render_scaling"),
-    "span": (".span", "render"),
-    "viewer": (".viewer", "render"),
-    "viewer-lat": (".viewer", "render_lat"),
-    "link": (".link", "render"),
-}
+# section -> (module, function) whose function(record) -> the section's markdown: the
+# benchmark's module and its `render`, but for the second sections of three modules.
+SECTIONS = {name: ("." + name.replace("-", "_"), "render") for name in
+            ("model", "hsr", "hsr-incr", "table52", "array", "yproc", "span", "viewer", "link")}
+SECTIONS.update({"model-fast": (".model", "render_fast"),
+                 "yproc-scaling": (".yproc", "render_scaling"),
+                 "viewer-lat": (".viewer", "render_lat")})
 
 
 def markers(name: str) -> tuple[str, str]:

@@ -91,7 +91,7 @@ def configure(ap) -> None:
     ap.add_argument("--ratio", type=int, default=3)
     ap.add_argument("--no-levers", action="store_true",
                     help="skip the lever table (5 more RTL builds and runs per scene)")
-    ap.add_argument("--write", action="store_true")
+    record.add_write(ap)
     ap.set_defaults(func=command)
 
 

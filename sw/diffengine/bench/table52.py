@@ -438,8 +438,7 @@ def dist_plots(plt, dist):
 
 def configure(ap) -> None:
     """The arguments of this subcommand (the `diffengine` tree calls this)."""
-    ap.add_argument("--write", action="store_true",
-                    help="keep the record in docs/bench, render docs/performance.md, docs/img/hsr_*.png")
+    record.add_write(ap, "docs/performance.md, docs/img/hsr_*.png")
     ap.add_argument("--quick", action="store_true", help="100 x 100 positions, no sweeps (a smoke run)")
     ap.add_argument("--queries", type=int, default=1000,
                     help="query positions per axis for Table 5.2 (default 1000: 1M, as the source)")

@@ -99,8 +99,7 @@ def configure(ap) -> None:
                     help="also drag with this yproc binary first, same run (record viewer-lat)")
     ap.add_argument("--baseline-label", default="baseline",
                     help="what the baseline binary is (e.g. 'main 4a92cc4'), for the table")
-    ap.add_argument("--write", action="store_true",
-                    help="keep the record in docs/bench and update docs/performance.md")
+    record.add_write(ap)
     ap.set_defaults(func=command)
 
 

@@ -226,7 +226,7 @@ def render_scaling(rec: dict) -> str:
 
 def configure(ap) -> None:
     """The arguments of this subcommand (the `diffengine` tree calls this)."""
-    ap.add_argument("--write", action="store_true", help="keep the record in docs/bench, render docs/performance.md and the plot")
+    record.add_write(ap, "docs/performance.md and the plot")
     ap.add_argument("--quick", action="store_true", help="default shading with AA only")
     ap.add_argument("--scaling", action="store_true", help="yproc scan time against triangle count (1K..100K)")
     ap.add_argument("--baseline-rev", help="with --scaling: also time the yproc of this git revision")

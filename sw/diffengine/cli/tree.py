@@ -58,9 +58,19 @@ def _description(module) -> str:
     return (module.__doc__ or "").strip().split("\n\n")[0]
 
 
-def build_parser() -> argparse.ArgumentParser:
+def add_module_commands(sub, table, package: str) -> None:
+    """One subcommand per (name, module, help) row of table (module relative to package):
+    the module's `configure(parser)` adds its options, its docstring describes it. The
+    command tree (MODULES) and `diffengine bench` (bench.main.BENCHES) are both built so."""
     import importlib
 
+    for name, module, help_ in table:
+        mod = importlib.import_module(module, package)
+        mod.configure(sub.add_parser(name, help=help_, description=_description(mod),
+                                     formatter_class=argparse.RawDescriptionHelpFormatter))
+
+
+def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="diffengine", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -132,10 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("capacity", help="print the capacity model report (Table 7.3)")
     s.set_defaults(func=cmd_capacity)
-    for name, module, help_ in MODULES:
-        mod = importlib.import_module(module, __package__)
-        mod.configure(sub.add_parser(name, help=help_, description=_description(mod),
-                                     formatter_class=argparse.RawDescriptionHelpFormatter))
+    add_module_commands(sub, MODULES, __package__)
     return p
 
 

@@ -37,13 +37,12 @@ raster and a JPEG at the spline stream's byte size, written next to the output.
 """
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .. import isa
+from .. import fail, isa
 from ..isa import Command
 from ..model import functional
 from . import raster as ER
@@ -442,9 +441,7 @@ def command(args) -> int:
             print(f"jpeg: quality {q}, PSNR {ES.psnr(dec, x):.2f} dB, {size} bytes -> {jpath}"
                   + ("" if size <= total else " (larger than the spline stream even at q=1)"))
     except EncodeError as e:
-        print(f"diffengine encode: error: {e}", file=sys.stderr)
-        return 2
+        return fail("diffengine encode", e, 2)
     except OSError as e:
-        print(f"diffengine encode: error: {e.filename or ''}: {e.strerror or e}", file=sys.stderr)
-        return 2
+        return fail("diffengine encode", f"{e.filename or ''}: {e.strerror or e}", 2)
     return 0

@@ -107,6 +107,13 @@ frame (the slots of each new line not on the longest common subsequence of its c
 with the previous frame's line, counted by yproc), as a histogram and per frame.
 
     diffengine anim [--anim sw/scenes/anim/cad_drag.anim] [--out out/anim] [--model fast|numpy]
+                    [--coherent] [--tol T]
+    diffengine anim --anim A --out D --coh-sweep [--frames N] [--legs 8,32,..] [--runs 4:coh:aa,..]
+
+--coherent keeps the previous frame's colour functions where they still meet the tolerance
+(yproc anim --coherent, docs/yproc.md section 11). --coh-sweep runs the animation at
+several light speeds (frames per `wander` leg) and tolerances, with and without it, and
+plots the median changed instructions per pattern line (sweep.png, sweep.json).
 
 The Load Monitor loop (docs/yproc.md section 10): --lod-compare runs the animation four
 times (open loop, look-ahead, the loop, the loop with the check before emission) and plots
@@ -203,6 +210,125 @@ def plot_changed(h: dict, path, title: str) -> None:
     ax[1].legend(fontsize=8)
     ax[1].set_title("per frame")
     fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+# ---- temporally coherent fitting: the light's speed and the tolerance (docs/yproc.md 11) -
+
+def anim_variant(anim_path, dst: Path, frames: int, leg: int | None = None) -> Path:
+    """A copy of an .anim file (its scene referenced by absolute path) with `frames` frames,
+    every ramp ending at the last frame, and (leg) every `wander` leg `leg` frames long."""
+    src = Path(anim_path).resolve()
+    out = []
+    for ln in src.read_text().splitlines():
+        tok = ln.split("#")[0].split()
+        if tok and tok[0] == "scene":
+            ln = f"scene {(src.parent / tok[1]).resolve()}"
+        elif tok and tok[0] == "frames":
+            ln = f"frames {frames}"
+        elif tok and tok[0] == "wander":
+            if leg is not None:
+                tok[3] = str(leg)
+            tok[-1] = str(frames - 1)
+            ln = " ".join(tok)
+        elif tok and tok[-4:-3] == ["from"]:
+            tok[-1] = str(frames - 1)
+            ln = " ".join(tok)
+        out.append(ln)
+    dst.write_text("\n".join(out) + "\n")
+    return dst
+
+
+def changed_summary(d: Path) -> dict:
+    """Changed instructions of one `yproc anim` run over the lines the pattern covers (more
+    than the background term in frame 0): medians of changed slots and commands per line
+    and colour over every later frame, lines with no change counted as 0; the worst
+    pixel against the exact shading (max_abs_err) over every frame; how far the exact
+    shading moves a frame (the per-frame median and 90th percentile over the pixels that
+    moved, their median over the frames)."""
+    st = json.loads((Path(d) / "anim_stats.json").read_text())
+    f0 = [lines_of_de48(Path(d) / "frame000" / f"{c}.de48") for c in "rgb"]
+    cover = np.array([[len(ln) // 6 - 1 > 3 for ln in ch] for ch in f0])          # (3, H)
+    per = st["frame"][1:]
+    cs = np.array([f["changed_slots"] for f in per])[:, cover]
+    cc = np.array([f["changed_cmds"] for f in per])[:, cover]
+    slots = np.array([[len(ln) // 6 - 1 for ln in ch] for ch in f0])[cover]
+    return {"median_slots": float(np.median(cs)), "p90_slots": float(np.percentile(cs, 90)),
+            "mean_slots": float(cs.mean()), "median_cmds": float(np.median(cc)),
+            "unchanged_share": float((cs == 0).mean()), "slots_per_line": float(slots.mean()),
+            "max_abs_err": max(f["max_abs_err"] for f in st["frame"]), "tol": st["tol"],
+            "exact_change_median": float(np.median([f["exact_change"]["median"] for f in per]))
+            if all("exact_change" in f for f in per) else None,
+            "exact_change_p90": float(np.median([f["exact_change"]["p90"] for f in per]))
+            if all("exact_change" in f for f in per) else None,
+            "frames_differing_from_full": st["frames_differing_from_full"],
+            "mean_incremental_ms": st["mean_incremental_ms"], "mean_full_ms": st["mean_full_ms"],
+            # YPD1 sends every changed line whole: its bytes against the changed slots' words
+            "delta_bytes_per_frame": float(np.mean([(Path(d) / f"frame{f['frame']:03d}.delta").stat().st_size
+                                                    for f in per])),
+            "changed_words_per_frame": float(np.mean([np.sum(f["changed_slots"]) for f in per]))}
+
+
+SWEEP_LEGS = (8, 32, 128, 512)
+SWEEP_RUNS = ((1, True, True), (4, True, True), (32, True, True), (4, True, False), (32, True, False),
+              (1, False, True), (4, False, True), (32, False, True))      # (tol, coherent, aa)
+
+
+def coherence_sweep(anim_path, out: Path, frames: int = 10, legs=SWEEP_LEGS, runs=SWEEP_RUNS) -> list[dict]:
+    """`yproc anim` of `anim_path` for every light speed (frames per `wander` leg) and run
+    (tolerance, --coherent, anti-aliasing; the plain runs at the slowest and fastest leg
+    only): changed instructions per pattern line (changed_summary). Writes sweep.json (with
+    the runs of an earlier sweep into `out` that were not repeated) and sweep.png."""
+    yproc = build_yproc()
+    res = []
+    for tol, coh, aa in runs:
+        for leg in (legs if coh else sorted({legs[0], legs[-1]})):
+            name = f"t{tol}_l{leg}_{'coh' if coh else 'plain'}{'' if aa else '_noaa'}"
+            a = anim_variant(anim_path, out / f"{name}.anim", frames, leg)
+            t0 = time.time()
+            flags = ["--tol", str(tol)] + (["--coherent"] if coh else []) + ([] if aa else ["--no-aa"])
+            r = subprocess.run([str(yproc), "anim", str(a), "-o", str(out / name), *flags],
+                               capture_output=True, text=True)
+            if r.returncode:
+                raise RuntimeError(f"yproc anim {a} {' '.join(flags)} failed:\n{r.stderr}")
+            row = {"tol": tol, "coherent": coh, "aa": aa, "leg": leg, **changed_summary(out / name)}
+            res.append(row)
+            print(f"  tol {tol:>2} {'coherent' if coh else 'plain   '} {'aa  ' if aa else 'noaa'} leg {leg:>3}: "
+                  f"median {row['median_slots']:.0f} slots / {row['median_cmds']:.0f} commands changed per "
+                  f"line, {100 * row['unchanged_share']:.0f} % of lines unchanged, worst pixel "
+                  f"{row['max_abs_err']:.2f} ({time.time() - t0:.0f} s)", flush=True)
+    # runs of an earlier sweep into the same folder stay unless re-run here
+    key = lambda r: (r["tol"], r["coherent"], r["aa"], r["leg"])
+    old = json.loads((out / "sweep.json").read_text()) if (out / "sweep.json").exists() else []
+    new = {key(r) for r in res}
+    res = sorted([r for r in old if key(r) not in new] + res, key=key)
+    (out / "sweep.json").write_text(json.dumps(res, indent=1) + "\n")
+    plot_sweep(res, out / "sweep.png", Path(anim_path).name, frames)
+    return res
+
+
+def plot_sweep(res: list[dict], path, title: str, frames: int) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
+    keys = sorted({(r["tol"], r["coherent"], r["aa"]) for r in res}, key=lambda k: (not k[1], not k[2], k[0]))
+    for k in keys:
+        rr = sorted((r for r in res if (r["tol"], r["coherent"], r["aa"]) == k), key=lambda r: r["leg"])
+        lab = f"tol {k[0]}, {'coherent' if k[1] else 'plain refit'}{'' if k[2] else ', no AA'}"
+        ls = "-" if k[1] else ":"
+        for i, key in enumerate(("median_slots", "median_cmds")):
+            ax[i].plot([r["leg"] for r in rr], [r[key] for r in rr], ls, marker="o", label=lab)
+    for i, what in enumerate(("instruction slots", "commands")):
+        ax[i].axhline(5, color="grey", lw=0.8)
+        ax[i].set_xscale("log", base=2)
+        ax[i].set_xlabel("frames per leg of the light's wander (50 Hz: /50 s)")
+        ax[i].set_ylabel(f"median changed {what} per line")
+        ax[i].set_ylim(bottom=0)
+    ax[0].legend(fontsize=7)
+    fig.suptitle(f"{title}: changed instructions per pattern line and colour, {frames} frames a run", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -492,6 +618,18 @@ def configure(ap) -> None:
                     "porches 4 + 8 (slots per line + 2; default 800, or the 640x480 mode)")
     ap.add_argument("--capacity", type=int, help="with --lod-loop: yproc's slots per line "
                     "(default: the mode's, or with --rtl the controller's HTotal - 2)")
+    ap.add_argument("--coherent", action="store_true",
+                    help="yproc anim --coherent: keep the previous frame's colour functions where they "
+                         "still meet the tolerance (docs/yproc.md section 11)")
+    ap.add_argument("--tol", type=float, help="yproc's fit tolerance (pixel units; default 1)")
+    ap.add_argument("--coh-sweep", action="store_true",
+                    help="instead: the animation at several light speeds and tolerances, with and "
+                         "without --coherent: changed instructions per line -> OUT/sweep.png, sweep.json")
+    ap.add_argument("--frames", type=int, default=10, help="with --coh-sweep: frames per run (default 10)")
+    ap.add_argument("--legs", help="with --coh-sweep: frames per leg of the light, comma-separated "
+                                   f"(default {','.join(map(str, SWEEP_LEGS))})")
+    ap.add_argument("--runs", help="with --coh-sweep: the runs as TOL:coh|plain:aa|noaa, comma-separated "
+                                   "(default: every one of SWEEP_RUNS)")
     ap.set_defaults(func=command)
 
 
@@ -545,10 +683,32 @@ def command(a) -> int:
             return 1
         print(f"wrote {out / 'lod.png'}, {out / 'lod.json'}")
         return 0
+    if a.coh_sweep:
+        print(f"anim: {a.anim} at light speeds {a.legs or SWEEP_LEGS} frames per leg, {a.frames} frames a run",
+              flush=True)
+        try:
+            legs = tuple(int(v) for v in a.legs.split(",")) if a.legs else SWEEP_LEGS
+            runs = SWEEP_RUNS
+            if a.runs:
+                runs = []
+                for r in a.runs.split(","):
+                    t, c, aa = r.split(":")
+                    if c not in ("coh", "plain") or aa not in ("aa", "noaa"):
+                        print(f"anim: --runs: '{r}' is not TOL:coh|plain:aa|noaa", file=sys.stderr)
+                        return 2
+                    runs.append((float(t) if "." in t else int(t), c == "coh", aa == "aa"))
+            coherence_sweep(a.anim, out, a.frames, legs, runs)
+        except RuntimeError as e:
+            print(f"anim: error: {e}", file=sys.stderr)
+            return 1
+        print(f"wrote {out / 'sweep.png'}, {out / 'sweep.json'}")
+        return 0
     yproc = build_yproc()
     t0 = time.time()
-    print(f"anim: yproc anim {a.anim} (each frame also re-rendered in full for the check)", flush=True)
-    res = subprocess.run([str(yproc), "anim", a.anim, "-o", str(out / "streams")],
+    flags = (["--coherent"] if a.coherent else []) + (["--tol", str(a.tol)] if a.tol else [])
+    print(f"anim: yproc anim {a.anim} {' '.join(flags)} (each frame also re-rendered in full for the check)",
+          flush=True)
+    res = subprocess.run([str(yproc), "anim", a.anim, "-o", str(out / "streams"), *flags],
                          capture_output=True, text=True)
     if res.returncode:
         print(f"anim: error: yproc anim failed:\n{res.stderr}", file=sys.stderr)

@@ -224,19 +224,20 @@ class Engine:
         self.undo_stack.append(self.state.copy())
         self.redo_stack.clear()
 
-    def undo(self) -> bool:
-        if not self.undo_stack:
+    def _travel(self, back: list, forth: list) -> bool:
+        """Undo (back = the undo stack) or redo: apply back's last state, keep the current
+        one on forth; False when back is empty."""
+        if not back:
             return False
-        self.redo_stack.append(self.state.copy())
-        self.apply(self.undo_stack.pop())
+        forth.append(self.state.copy())
+        self.apply(back.pop())
         return True
 
+    def undo(self) -> bool:
+        return self._travel(self.undo_stack, self.redo_stack)
+
     def redo(self) -> bool:
-        if not self.redo_stack:
-            return False
-        self.undo_stack.append(self.state.copy())
-        self.apply(self.redo_stack.pop())
-        return True
+        return self._travel(self.redo_stack, self.undo_stack)
 
     # ---- frames ------------------------------------------------------------------------
     def frame(self, coarse: bool | None = False) -> Frame:

@@ -16,14 +16,13 @@ import asyncio
 import json
 import math
 import struct
-import sys
 import threading
 import time
 from pathlib import Path
 
 import numpy as np
 
-from .. import REPO
+from .. import REPO, fail
 from .engine import SHADINGS, Engine, EngineError
 
 PAGE = Path(__file__).with_name("page.html")
@@ -321,14 +320,11 @@ def configure(ap) -> None:
 
 def command(a) -> int:
     if not Path(a.scene).is_file():
-        print(f"view: error: {a.scene}: no such scene file", file=sys.stderr)
-        return 1
+        return fail("view", f"{a.scene}: no such scene file")
     try:
         serve(a.scene, a.port, a.budget_ms, model=a.model)
     except EngineError as ex:
-        print(f"view: error: {ex}", file=sys.stderr)
-        return 1
+        return fail("view", ex)
     except OSError as ex:
-        print(f"view: error: cannot listen on {HOST}:{a.port}: {ex}", file=sys.stderr)
-        return 1
+        return fail("view", f"cannot listen on {HOST}:{a.port}: {ex}")
     return 0

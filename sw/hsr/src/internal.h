@@ -142,6 +142,17 @@ void pair_order_make(const hsr_domain *dp, hsr_plane pp, int idp,
 /* obj.c helpers shared with scene.c and mtl.c */
 int scene_grow(void **p, int *cap, int need, size_t sz);
 int scene_tokens(char *line, char **tok, int max);
+/* The readers' error message: err = "name:lineno: " and the formatted text (when err is
+ * not NULL); returns st. */
+hsr_status hsr_text_error(char *err, size_t errlen, const char *name, int lineno,
+                          hsr_status st, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+/* The readers' line loop: the next line of *p with tokens (blank and comment lines are
+ * skipped; *lineno counts every line) into buf/tok, at most max tokens. Returns the number
+ * of tokens, 0 at the end of the text, or -1 for a line too long or with too many items
+ * (the message in err, as hsr_text_error). */
+int hsr_text_next(const char **p, int *lineno, char *buf, size_t cap, char **tok, int max,
+                  const char *name, char *err, size_t errlen);
 
 /* mtl.c: read the .mtl file at path and append its materials (newmtl, Kd,
  * Ks, Ns, d, Tr) to sc->mat with file = its index in sc->files + 1.

@@ -29,15 +29,34 @@ static hsr_status put_rings(FILE *f, const hsr_domain *d)
     return HSR_OK;
 }
 
-hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
+/* The start both domain dumps share: the arguments checked, the file opened (*f) and
+ * written up to the opening of its list (named list). */
+static hsr_status open_dump(FILE **f, const char *path, const hsr_ctx *h, const hsr_scene *sc,
+                            const char *format, const char *list)
 {
     if (!path || !h || !sc) return HSR_EINVAL;
-    FILE *f = fopen(path, "w");
-    if (!f) return HSR_EIO;
+    *f = fopen(path, "w");
+    if (!*f) return HSR_EIO;
+    fprintf(*f, "{\"format\": \"%s\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
+                " \"mlr_count\": %d, \"%s\": [", format, HSR_SUBPIXEL, sc->width, sc->height,
+            hsr_mlr_slots(h), list);
+    return HSR_OK;
+}
+
+/* ... and its end: the list closed, the file closed; st, or HSR_EIO if closing failed. */
+static hsr_status close_dump(FILE *f, hsr_status st)
+{
+    fprintf(f, "\n]}\n");
+    if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
+    return st;
+}
+
+hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
+{
+    FILE *f;
+    hsr_status st = open_dump(&f, path, h, sc, "hsr-llr-1", "domains");
+    if (st != HSR_OK) return st;
     const double S = HSR_SUBPIXEL;
-    hsr_status st = HSR_OK;
-    fprintf(f, "{\"format\": \"hsr-llr-1\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
-               " \"mlr_count\": %d, \"domains\": [", HSR_SUBPIXEL, sc->width, sc->height, hsr_mlr_slots(h));
     int first = 1;
     for (int s = 0; s < hsr_llr_slots(h) && st == HSR_OK; s++) {
         const hsr_domain *d; const int *par; int nv, np;
@@ -54,9 +73,7 @@ hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scen
         st = put_rings(f, d);
         fprintf(f, "}");
     }
-    fprintf(f, "\n]}\n");
-    if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
-    return st;
+    return close_dump(f, st);
 }
 
 /* --dump-input: every MLR domain (the projected, clipped, quantised input faces) with id,
@@ -64,13 +81,10 @@ hsr_status hsr_write_llr_json(const char *path, const hsr_ctx *h, const hsr_scen
  * docs/hsr.md; used by sw/tests/test_hsr_oracle.py). */
 hsr_status hsr_write_input_json(const char *path, const hsr_ctx *h, const hsr_scene *sc)
 {
-    if (!path || !h || !sc) return HSR_EINVAL;
-    FILE *f = fopen(path, "w");
-    if (!f) return HSR_EIO;
+    FILE *f;
+    hsr_status st = open_dump(&f, path, h, sc, "hsr-input-1", "polygons");
+    if (st != HSR_OK) return st;
     const double S = HSR_SUBPIXEL;
-    hsr_status st = HSR_OK;
-    fprintf(f, "{\"format\": \"hsr-input-1\", \"units_per_pixel\": %d, \"width\": %d, \"height\": %d,\n"
-               " \"mlr_count\": %d, \"polygons\": [", HSR_SUBPIXEL, sc->width, sc->height, hsr_mlr_slots(h));
     for (int id = 0, first = 1; id < hsr_mlr_slots(h) && st == HSR_OK; id++) {
         const hsr_domain *d; hsr_plane pl; double op;
         if (!hsr_mlr_get(h, id, &d, &pl, &op, NULL, NULL)) continue;   /* removed (--ops) */
@@ -81,9 +95,7 @@ hsr_status hsr_write_input_json(const char *path, const hsr_ctx *h, const hsr_sc
         fprintf(f, "}");
         first = 0;
     }
-    fprintf(f, "\n]}\n");
-    if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
-    return st;
+    return close_dump(f, st);
 }
 
 /* doubles as %.17g: read back by Python's json they are the same doubles */

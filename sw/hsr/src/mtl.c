@@ -40,14 +40,9 @@ hsr_status scene_mtl_load(hsr_scene *sc, const char *path, const char *where, ch
     char buf[4096], *tok[64];
     const char *p = text;
     st = HSR_OK;
-    while (*p) {
-        lineno++;
-#define FAIL(s_, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", path, lineno); \
-        if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } st = s_; goto done; } while (0)
-        int nt = hsr_text_line(&p, buf, sizeof buf, tok, 64);
-        if (nt == -1) FAIL(HSR_EPARSE, "line too long");
-        if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
-        if (nt == 0) continue;
+    int nt;
+    while ((nt = hsr_text_next(&p, &lineno, buf, sizeof buf, tok, 64, path, err, errlen)) > 0) {
+#define FAIL(s_, ...) do { st = hsr_text_error(err, errlen, path, lineno, s_, __VA_ARGS__); goto done; } while (0)
         const char *k = tok[0];
         int known = !strcmp(k, "Kd") || !strcmp(k, "Ks") || !strcmp(k, "Ns") || !strcmp(k, "d") || !strcmp(k, "Tr");
         if (!strcmp(k, "newmtl")) {
@@ -80,6 +75,7 @@ hsr_status scene_mtl_load(hsr_scene *sc, const char *path, const char *where, ch
         }
 #undef FAIL
     }
+    if (nt < 0) st = HSR_EPARSE;
 done:
     free(text);
     return st;

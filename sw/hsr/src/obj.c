@@ -4,6 +4,7 @@
  * usemtl; other statements are ignored.  Errors name file and line
  * (docs/hsr.md, "OBJ"). */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,6 +48,36 @@ int hsr_text_line(const char **p, char *buf, size_t cap, char **tok, int max)
     *p = e ? e + 1 : *p + n;
     int nt = scene_tokens(buf, tok, max);
     return nt < 0 ? -2 : nt;
+}
+
+hsr_status hsr_text_error(char *err, size_t errlen, const char *name, int lineno,
+                          hsr_status st, const char *fmt, ...)
+{
+    if (!err) return st;
+    int k = snprintf(err, errlen, "%s:%d: ", name, lineno);
+    if (k >= 0 && (size_t)k < errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err + k, errlen - (size_t)k, fmt, ap);
+        va_end(ap);
+    }
+    return st;
+}
+
+int hsr_text_next(const char **p, int *lineno, char *buf, size_t cap, char **tok, int max,
+                  const char *name, char *err, size_t errlen)
+{
+    while (**p) {
+        ++*lineno;
+        int nt = hsr_text_line(p, buf, cap, tok, max);
+        if (nt > 0) return nt;
+        if (nt < 0) {
+            hsr_text_error(err, errlen, name, *lineno, HSR_EPARSE, "%s",
+                           nt == -1 ? "line too long" : "too many items on one line");
+            return -1;
+        }
+    }
+    return 0;
 }
 
 int hsr_text_num(const char *s, double *v)
@@ -95,14 +126,9 @@ hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name, int 
     int cv[512], cn[512], tri[3 * 510];
     double pts[3 * 512];
     const char *p = text;
-    while (*p) {
-        lineno++;
-#define FAIL(st, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", name, lineno); \
-        if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } return st; } while (0)
-        int nt = hsr_text_line(&p, buf, sizeof buf, tok, 512);
-        if (nt == -1) FAIL(HSR_EPARSE, "line too long");
-        if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
-        if (nt == 0) continue;
+    int nt;
+    while ((nt = hsr_text_next(&p, &lineno, buf, sizeof buf, tok, 512, name, err, errlen)) > 0) {
+#define FAIL(st, ...) return hsr_text_error(err, errlen, name, lineno, st, __VA_ARGS__)
         if (!strcmp(tok[0], "v") || !strcmp(tok[0], "vn") || !strcmp(tok[0], "vt")) {
             int isv = tok[0][1] == 0, isn = tok[0][1] == 'n';
             double x[6];
@@ -186,5 +212,5 @@ hsr_status hsr_obj_parse(hsr_scene *sc, const char *text, const char *name, int 
         }
 #undef FAIL
     }
-    return HSR_OK;
+    return nt < 0 ? HSR_EPARSE : HSR_OK;
 }

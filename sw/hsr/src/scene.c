@@ -74,14 +74,9 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
     int lineno = 0;
     char buf[4096], *tok[64];
     const char *p = text;
-    while (*p) {
-        lineno++;
-#define FAIL(st, ...) do { if (err) { int k_ = snprintf(err, errlen, "%s:%d: ", name, lineno); \
-        if (k_ >= 0 && (size_t)k_ < errlen) snprintf(err + k_, errlen - (size_t)k_, __VA_ARGS__); } return st; } while (0)
-        int nt = hsr_text_line(&p, buf, sizeof buf, tok, 64);
-        if (nt == -1) FAIL(HSR_EPARSE, "line too long");
-        if (nt == -2) FAIL(HSR_EPARSE, "too many items on one line");
-        if (nt == 0) continue;
+    int nt;
+    while ((nt = hsr_text_next(&p, &lineno, buf, sizeof buf, tok, 64, name, err, errlen)) > 0) {
+#define FAIL(st, ...) return hsr_text_error(err, errlen, name, lineno, st, __VA_ARGS__)
         double v[16];
         const char *k = tok[0];
         if (!strcmp(k, "screen")) {
@@ -182,7 +177,7 @@ hsr_status hsr_scene_parse(hsr_scene *sc, const char *text, const char *name, co
         } else FAIL(HSR_EPARSE, "unknown statement '%s'", k);
 #undef FAIL
     }
-    return HSR_OK;
+    return nt < 0 ? HSR_EPARSE : HSR_OK;
 }
 
 hsr_status hsr_scene_load(const char *path, hsr_scene **out, char *err, size_t errlen)

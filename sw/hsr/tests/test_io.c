@@ -25,14 +25,28 @@ static hsr_scene *cube_scene(const char *extra)
     return sc;
 }
 
-/* The cube scene (extra appended to its material) through HSR: 0 when a step fails. */
-static int cube_built(const char *extra, hsr_scene **sc, hsr_ctx **h, double **shade)
+/* A scene through HSR: the scene, its context and the shading, freed by built_free. */
+typedef struct {
+    hsr_scene *sc;
+    hsr_ctx *h;
+    double *shade;
+} built;
+
+static void built_free(built *b)
 {
-    *sc = cube_scene(extra);
-    *h = NULL;
-    *shade = NULL;
-    CHECK(*sc && hsr_scene_build(*sc, h, shade) == HSR_OK);
-    if (!*h) { hsr_scene_free(*sc); return 0; }
+    free(b->shade);
+    hsr_destroy(b->h);
+    hsr_scene_free(b->sc);
+}
+
+/* The cube scene (extra appended to its material) through HSR: 0 when a step fails. */
+static int cube_built(const char *extra, built *b)
+{
+    b->sc = cube_scene(extra);
+    b->h = NULL;
+    b->shade = NULL;
+    CHECK(b->sc && hsr_scene_build(b->sc, &b->h, &b->shade) == HSR_OK);
+    if (!b->h) { hsr_scene_free(b->sc); return 0; }
     return 1;
 }
 
@@ -77,32 +91,49 @@ static void test_malformed_input_errors_name_file_and_line(void)
     expect_err(0, "obj a.obj material nope\n", "s.scene:1: unknown material 'nope'");
 }
 
+/* The readers' shared line loop (hsr_text_next): a line longer than the line buffer and
+ * one with more items than a reader takes are errors at their line in every reader. */
+static void test_long_and_crowded_lines_name_file_and_line(void)
+{
+    static char text[8192];
+    int n = snprintf(text, sizeof text, "screen 10 10\n# comment\nscreen");
+    while (n < 4200) text[n++] = ' ';
+    snprintf(text + n, sizeof text - (size_t)n, "10 10\n");
+    expect_err(0, text, "s.scene:3: line too long");
+    n = snprintf(text, sizeof text, "\n\ngrid");
+    for (int i = 0; i < 64; i++) n += snprintf(text + n, sizeof text - (size_t)n, " 1");
+    expect_err(0, text, "s.scene:3: too many items on one line");
+    n = snprintf(text, sizeof text, "v 0 0 0\nf");
+    for (int i = 0; i < 512; i++) n += snprintf(text + n, sizeof text - (size_t)n, " 1");
+    expect_err(1, text, "m.obj:2: too many items on one line");
+    expect_err(1, "v 0 0 0\n\nv 1 0 0 0 0\n", "m.obj:3: 'v' needs 3");
+}
+
 static void test_cube_scene_three_faces_visible(void)
 {
-    hsr_scene *sc;
-    hsr_ctx *h;
-    double *shade;
-    if (!cube_built("", &sc, &h, &shade)) return;
+    built b;
+    if (!cube_built("", &b)) return;
+    hsr_scene *sc = b.sc;
+    hsr_ctx *h = b.h;
     int vis = 0;
     for (int id = 0; id < 6; id++) vis += t_visible_area(h, id) > 0;
     CHECK(vis == 3);
     CHECK(hsr_check(h) == HSR_OK);
     CHECK(hsr_write_llr_json("build/test_cube.json", h, sc) == HSR_OK);
-    CHECK(hsr_write_svg("build/test_cube.svg", h, sc, shade) == HSR_OK);
+    CHECK(hsr_write_svg("build/test_cube.svg", h, sc, b.shade) == HSR_OK);
     FILE *f = fopen("build/test_cube.json", "r");
     char buf[256] = "";
     CHECK(f && fgets(buf, sizeof buf, f) && strstr(buf, "hsr-llr-1"));
     if (f) fclose(f);
-    CHECK(hsr_write_svg("/nonexistent/x.svg", h, sc, shade) == HSR_EIO);
-    free(shade); hsr_destroy(h); hsr_scene_free(sc);
+    CHECK(hsr_write_svg("/nonexistent/x.svg", h, sc, b.shade) == HSR_EIO);
+    built_free(&b);
 }
 
 static void test_transparent_cube_shows_back_faces(void)
 {
-    hsr_scene *sc;
-    hsr_ctx *h;
-    double *shade;
-    if (!cube_built(" opacity 0.5", &sc, &h, &shade)) return;
+    built b;
+    if (!cube_built(" opacity 0.5", &b)) return;
+    hsr_ctx *h = b.h;
     int maxdepth = 0;
     for (int s = 0; s < hsr_llr_slots(h); s++) {
         int nv;
@@ -110,7 +141,7 @@ static void test_transparent_cube_shows_back_faces(void)
     }
     CHECK(maxdepth == 2);      /* front face over back face everywhere */
     CHECK(hsr_check(h) == HSR_OK);
-    free(shade); hsr_destroy(h); hsr_scene_free(sc);
+    built_free(&b);
 }
 
 static void test_face_behind_camera_is_clipped(void)
@@ -132,6 +163,7 @@ void suite_io(void)
 {
     RUN(test_obj_faces_slashes_negative_indices);
     RUN(test_malformed_input_errors_name_file_and_line);
+    RUN(test_long_and_crowded_lines_name_file_and_line);
     RUN(test_cube_scene_three_faces_visible);
     RUN(test_transparent_cube_shows_back_faces);
     RUN(test_face_behind_camera_is_clipped);

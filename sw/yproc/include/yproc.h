@@ -31,6 +31,16 @@ typedef struct yp_options {
     int no_degrade;      /* 1: no look-ahead degradation inside a line: a line over the
                           * capacity is emitted as is and overflows (the controller drops
                           * it); the Load Monitor loop (yp_lod_update) adapts instead */
+    /* temporally coherent fitting (docs/yproc.md section 11): the previous frame's lines
+     * ([3 * height], colour c line y at c * height + y), or NULL.  Where a colour
+     * function of the previous frame still meets the tolerance against the new exact
+     * shading its instructions are kept, and only the failing spans are refitted: the
+     * frame then depends on the one before it (the error bound, not the instruction,
+     * is the contract) */
+    const yp_cmdlist *prev;
+    int coherent;        /* 1: the line structure of coherent fitting, from the first frame
+                          * on (a partly covered pixel at either end of a pattern's span gets
+                          * its own Eval1, so the spline between them can stay) */
 } yp_options;
 void yp_options_default(yp_options *o);            /* 640x480 capacity, aa, phong, tol 1 */
 /* slots per line of a video mode "640x480" | "640x485" | "1280x1024"
@@ -114,6 +124,8 @@ int yp_cmdlist_equal(const yp_cmdlist *a, const yp_cmdlist *b);
 /* instruction slots of b not matched, in order, by a (longest common subsequence of
  * the commands): the instructions a frame delta really changes on a line */
 int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b);
+/* the same, and in *cmds (if not NULL) the commands of b not matched */
+int yp_cmdlist_changed(const yp_cmdlist *a, const yp_cmdlist *b, int *cmds);
 
 /* ---- level of detail from the Load Monitor (yp_lod.c, docs/yproc.md section 10) ---- */
 #define YP_LOD_MAX 5

@@ -238,20 +238,24 @@ static int cmd_eq(const yp_cmd *p, const yp_cmd *q)
            && p->v[0] == q->v[0] && p->v[1] == q->v[1] && p->v[2] == q->v[2];
 }
 
-int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b)
+int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b) { return yp_cmdlist_changed(a, b, NULL); }
+
+int yp_cmdlist_changed(const yp_cmdlist *a, const yp_cmdlist *b, int *cmds)
 {
     /* LCS by dynamic programming over the commands after the common head and tail
      * (a line changes in a few places; the table is small or absent) */
     int h = 0, na = a->n, nb = b->n;
     while (h < na && h < nb && cmd_eq(&a->c[h], &b->c[h])) h++;
     while (na > h && nb > h && cmd_eq(&a->c[na - 1], &b->c[nb - 1])) { na--; nb--; }
-    int m = na - h, n = nb - h, changed = 0;
+    int m = na - h, n = nb - h, changed = 0, nc = 0;
+    if (cmds) *cmds = 0;
     if (m == 0 || n == 0) {
         for (int j = h; j < nb; j++) changed += yp_cmd_slots(&b->c[j]);
+        if (cmds) *cmds = nb - h;
         return changed;
     }
     int *t = calloc((size_t)(m + 1) * (size_t)(n + 1), sizeof(int));
-    if (!t) { for (int j = h; j < nb; j++) changed += yp_cmd_slots(&b->c[j]); return changed; }
+    if (!t) { for (int j = h; j < nb; j++) changed += yp_cmd_slots(&b->c[j]); if (cmds) *cmds = nb - h; return changed; }
 #define T(i, j) t[(size_t)(i) * (size_t)(n + 1) + (size_t)(j)]
     for (int i = m - 1; i >= 0; i--)
         for (int j = n - 1; j >= 0; j--)
@@ -261,9 +265,10 @@ int yp_cmdlist_changed_slots(const yp_cmdlist *a, const yp_cmdlist *b)
     for (int i = 0, j = 0; j < n;) {
         if (i < m && cmd_eq(&a->c[h + i], &b->c[h + j])) { i++; j++; }
         else if (i < m && T(i + 1, j) >= T(i, j + 1)) i++;
-        else { changed += yp_cmd_slots(&b->c[h + j]); j++; }
+        else { changed += yp_cmd_slots(&b->c[h + j]); nc++; j++; }
     }
 #undef T
     free(t);
+    if (cmds) *cmds = nc;
     return changed;
 }

@@ -28,6 +28,7 @@
 #define COV_Q 65536.0     /* coverage is rounded to 2^-16 of a pixel: hides the sub-unit slivers in
                            * which an incremental HSR result may differ from a rebuild */
 #define TOL_PARTIAL (1.0 / 64)  /* fit tolerance at partly covered pixels, pixel units */
+#define YP_COH_HYST 0.5         /* coherent fitting: new pieces at half the tolerance [choice] */
 
 typedef struct entry {
     double area;
@@ -212,6 +213,12 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         }
         double *f = s->tmp;
         hsr_status st = HSR_OK;
+        /* coherent fitting: the previous frame's line, its terms before Acc_mode (the
+         * colour functions) and after (the specular terms) */
+        const yp_cmdlist *pl = s->o->prev ? &s->o->prev[c * s->H + y] : NULL;
+        int pacc = 0;
+        while (pl && pacc < pl->n && pl->c[pacc].op != YP_ACCMODE) pacc++;
+        const double hyst = s->o->coherent ? YP_COH_HYST : 1;
         for (int lev = 1; lev <= e->maxlev && st == HSR_OK; lev++) {
             /* target: cov * colour over the covered pixels (Dis elsewhere) */
             for (int x = a; x <= cl; x++) {
@@ -228,8 +235,33 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
              * pixel shared by several patterns add up to its box average */
             double *tv = s->tolv;
             for (int x = a; x <= cl; x++) tv[x - a] = cov[x - x0] < 1 ? fmin(tol, TOL_PARTIAL) : tol;
-            st = push_dis(&s->wl[lev], cv, a, a + n, a);
-            if (st == HSR_OK && yp_fit(f, cv, tv, n, a, lev - 1, tol, 0, &s->wl[lev]) < 0) st = HSR_ELIMIT;
+            /* coherent fitting: a partly covered pixel at either end of the span gets an
+             * Eval1 of its own, so that the spline between them can stay when the light
+             * moves (the edge pixels' tight tolerance would otherwise change its start and
+             * its last knot in every frame) */
+            int ea = 0, eb = 0;
+            if (s->o->coherent && n > 4) {
+                ea = cov[a - x0] < 1 && cv[1];
+                eb = cov[cl - x0] < 1 && cv[n - 2];
+            }
+            st = push_dis(&s->wl[lev], cv, a + ea, a + n - eb, a);
+            if (st == HSR_OK && yp_fit_coherent(f + ea, cv + ea, tv + ea, n - ea - eb, a + ea, lev - 1, tol, 0, hyst, pl, 0, pacc,
+                                                &s->wl[lev], NULL) < 0)
+                st = HSR_ELIMIT;
+            for (int k = 0; k < 2 && st == HSR_OK; k++) {
+                if (!(k ? eb : ea)) continue;
+                int x = k ? cl : a;
+                yp_cmd e1 = {YP_EVAL, 0, (uint16_t)x, 1, {q24(f[x - a]), 0, 0}};
+                /* the previous frame's Eval1 of this pixel stays while within cov * tol of
+                 * the target: the pixel's error, summed over the patterns sharing it, stays
+                 * within tol, as on a fully covered pixel */
+                for (int i = 0; pl && i < pacc; i++) {
+                    const yp_cmd *q = &pl->c[i];
+                    if (q->op == YP_EVAL && q->order == 0 && q->x == x && q->dx == 1
+                        && fabs((double)q->v[0] / YP_ONE - f[x - a]) <= cov[x - x0] * tol) { e1 = *q; break; }
+                }
+                st = yp_cmdlist_push(&s->wl[lev], e1);
+            }
             if (st == HSR_OK) st = arena_list(&s->ar, &s->wl[lev], &e->lv[lev]);
             e->cost[lev] = e->lv[lev].slots;
         }
@@ -239,9 +271,20 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             unsigned char *use = s->use2;
             for (int x = a; x <= cl; x++)
                 if (full[x] && s->fs[3 * nl * x + 3 * l + c] > ltol) { if (sa < 0) sa = x; sb = x; }
+            /* coherent: a specular term of the previous frame that starts at or left of sa
+             * over fully covered pixels keeps its start (its end grows if need be), so its
+             * Sets can stay; not if it is more than twice (and 32 pixels) longer */
+            for (int i = pacc + 1; pl && i < pl->n; i++) {
+                const yp_cmd *e = &pl->c[i];
+                int ea = e->x, eb = e->x + e->dx - 1 > sb ? e->x + e->dx - 1 : sb, okr = 1;
+                if (e->op != YP_EVAL || e->order != 2 || ea > sa || ea < a || eb > cl || eb + 1 - ea > 2 * (sb + 1 - sa) + 32) continue;
+                for (int x = ea; x <= eb && okr; x++) okr = full[x];
+                if (okr) { sa = ea; sb = eb; break; }
+            }
             for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
             st = push_dis(&s->wspec, use, sa, sb + 1, sa);
-            if (st == HSR_OK && yp_fit(f, use, NULL, sb + 1 - sa, sa, 2, ltol, 1, &s->wspec) < 0) st = HSR_ELIMIT;
+            if (st == HSR_OK && yp_fit_coherent(f, use, NULL, sb + 1 - sa, sa, 2, ltol, 1, hyst, pl, pacc, pl ? pl->n : 0, &s->wspec, NULL) < 0)
+                st = HSR_ELIMIT;
         }
         if (st == HSR_OK) st = arena_list(&s->ar, &s->wspec, &e->spec);
         /* the texture term: cov * texture over the covered pixels, one Eval3 spline whose

@@ -3,6 +3,7 @@
 #include "t.h"
 
 void suite_yp_tex_lod(void);   /* test_yp_tex_lod.c */
+void suite_yp_coh(void);       /* test_yp_coh.c */
 void suite_yp_tess(void);      /* test_yp_tess.c */
 
 int main(int argc, char **argv)
@@ -12,6 +13,7 @@ int main(int argc, char **argv)
     suite_yp();
     suite_obj_shading();
     suite_yp_tex_lod();
+    suite_yp_coh();
     suite_yp_tess();
     return t_report();
 }

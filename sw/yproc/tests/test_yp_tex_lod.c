@@ -33,7 +33,12 @@ static void make_pattern_files(void)
  * textures unless ext), HSR built, a frame, default options */
 typedef struct tanim { yp_anim *an; hsr_scene *sc; yp_shader *sh; hsr_ctx *h; yp_frame *fr; yp_options o; int W, H; } tanim;
 
-static int tanim_open(tanim *t, const char *path, int ext)
+static void tanim_close(tanim *t)
+{
+    yp_frame_free(t->fr); hsr_destroy(t->h); yp_shader_free(t->sh); yp_anim_free(t->an);
+}
+
+static int tanim_make(tanim *t, const char *path, int ext)
 {
     memset(t, 0, sizeof *t);
     char err[256] = "";
@@ -48,17 +53,20 @@ static int tanim_open(tanim *t, const char *path, int ext)
     return yp_frame_new(t->W, t->H, &t->fr) == HSR_OK;
 }
 
-static void tanim_close(tanim *t)
+/* tanim_make, a test failure when it fails (and what it made freed): 0 then. */
+static int tanim_open(tanim *t, const char *path, int ext)
 {
-    yp_frame_free(t->fr); hsr_destroy(t->h); yp_shader_free(t->sh); yp_anim_free(t->an);
+    const int ok = tanim_make(t, path, ext);
+    CHECK(ok);
+    if (!ok) tanim_close(t);
+    return ok;
 }
 
 static void test_texture_is_c1_piecewise_quadratic_along_u(void)
 {
     make_pattern_files();
     tanim ta;
-    CHECK(tanim_open(&ta, "build/t_tex.anim", 1));
-    if (!ta.fr) { tanim_close(&ta); return; }
+    if (!tanim_open(&ta, "build/t_tex.anim", 1)) return;
     yp_shader *sh = ta.sh;
     char err[256] = "";
     CHECK(yp_texture_at(sh, 0, (double[3]){0, 0, 0}) >= 0);
@@ -132,8 +140,7 @@ static void test_wander_moves_continuously_towards_random_points_in_its_box(void
     write_file("build/t_w.anim", "scene t_tex.scene\nframes 40\npointlight 0 0.4 0.3 0.9\n"
                "wander 0 99 5 -1.8 -1.3 0.5 1.8 1.3 1.2 from 0 to 39\n");
     tanim ta;
-    CHECK(tanim_open(&ta, "build/t_w.anim", 1));
-    if (!ta.fr) { tanim_close(&ta); return; }
+    if (!tanim_open(&ta, "build/t_w.anim", 1)) return;
     yp_anim *an = ta.an;
     yp_shader *sh = ta.sh;
     char err[256] = "";
@@ -199,65 +206,104 @@ static void test_changed_slots_is_the_lcs_of_the_commands(void)
 /* The Fig. 7.27 animation in small: every frame equals its full re-render, the texture
  * term is there (more instructions than without it) and only a part of each line
  * changes from frame to frame (the light's terms, not the texture's). */
+/* worst |array pixel - exact shading| of a frame (yp_simulate_line against fr->ideal) */
+static double frame_worst(const yp_frame *fr)
+{
+    uint16_t pix[64];
+    double worst = 0;
+    for (int c = 0; c < 3; c++)
+        for (int y = 0; y < fr->height; y++) {
+            yp_simulate_line(&fr->line[c * fr->height + y], fr->width, pix);
+            for (int x = 0; x < fr->width; x++) worst = fmax(worst, fabs(pix[x] - fr->ideal[((size_t)c * fr->height + y) * fr->width + x]));
+        }
+    return worst;
+}
+
+/* The animation frame by frame at tolerance tol (coherent: yp_options.coherent and the
+ * previous frame's lines as .prev): every incremental frame equals the full rebuild
+ * (HSR rebuilt, every line) from the same previous frame; returns the changed slots
+ * (LCS), the slots of all frames and the worst pixel against the exact shading. */
+static void textured_run(const char *path, double tol, int coherent, long *changed, long *total, double *worst)
+{
+    tanim t;
+    *changed = *total = 0; *worst = 0;
+    if (!tanim_open(&t, path, 1)) return;
+    int H = t.H, W = t.W;
+    double *shade;
+    t.o.tol = tol; t.o.coherent = coherent;
+    CHECK(yp_scan(t.sh, t.h, &t.o, 0, H, t.fr) == HSR_OK);
+    *worst = frame_worst(t.fr);
+    yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
+    for (int f = 1; prev && f < yp_anim_frames(t.an); f++) {
+        for (int i = 0; i < 3 * H; i++) {
+            yp_cmdlist_free(&prev[i]);
+            for (int k = 0; k < t.fr->line[i].n; k++) yp_cmdlist_push(&prev[i], t.fr->line[i].c[k]);
+        }
+        if (coherent) t.o.prev = prev;
+        int y0, y1;
+        CHECK(yp_anim_apply(t.an, f, t.h, t.sh, &y0, &y1) == HSR_OK);
+        CHECK(y0 == 0 && y1 == H);                 /* a light moved: every line */
+        CHECK(yp_scan(t.sh, t.h, &t.o, y0, y1, t.fr) == HSR_OK);
+        hsr_ctx *hf = NULL;
+        yp_frame *ff = NULL;
+        CHECK(hsr_scene_build(t.sc, &hf, &shade) == HSR_OK);
+        free(shade);
+        CHECK(yp_frame_new(W, H, &ff) == HSR_OK);
+        CHECK(yp_scan(t.sh, hf, &t.o, 0, H, ff) == HSR_OK);
+        for (int i = 0; i < 3 * H; i++) {
+            CHECK(yp_cmdlist_equal(&ff->line[i], &t.fr->line[i]));
+            *changed += yp_cmdlist_changed_slots(&prev[i], &t.fr->line[i]);
+            *total += t.fr->line[i].slots;
+        }
+        *worst = fmax(*worst, frame_worst(t.fr));
+        yp_frame_free(ff); hsr_destroy(hf);
+    }
+    for (int i = 0; prev && i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
+    free(prev);
+    tanim_close(&t);
+}
+
 static void test_textured_anim_changes_only_the_light_terms(void)
 {
     make_pattern_files();
     tanim t;
-    CHECK(tanim_open(&t, "build/t_tex.anim", 0));
-    if (!t.fr) { tanim_close(&t); return; }
-    yp_anim *an = t.an;
-    hsr_scene *sc = t.sc;
-    yp_shader *sh = t.sh;
-    hsr_ctx *h = t.h;
-    double *shade;
+    if (!tanim_open(&t, "build/t_tex.anim", 0)) return;
     yp_frame *fr = t.fr, *plain = NULL;
-    yp_options o = t.o;
     int H = t.H, W = t.W;
     CHECK(yp_frame_new(W, H, &plain) == HSR_OK);
-    CHECK(yp_scan(sh, h, &o, 0, H, plain) == HSR_OK);          /* no texture yet */
-    CHECK(yp_anim_apply(an, 0, NULL, sh, NULL, NULL) == HSR_OK);
-    CHECK(yp_scan(sh, h, &o, 0, H, fr) == HSR_OK);
+    CHECK(yp_scan(t.sh, t.h, &t.o, 0, H, plain) == HSR_OK);          /* no texture yet */
+    CHECK(yp_anim_apply(t.an, 0, NULL, t.sh, NULL, NULL) == HSR_OK);
+    CHECK(yp_scan(t.sh, t.h, &t.o, 0, H, fr) == HSR_OK);
     long sl_plain = 0, sl_tex = 0, changed = 0, total = 0;
     for (int i = 0; i < 3 * H; i++) { sl_plain += plain->line[i].slots; sl_tex += fr->line[i].slots; }
     CHECK(sl_tex > sl_plain + 3 * H);
     /* the frame is within the fit's bound of the exact target (texture included) */
-    uint16_t pix[48];
-    double worst = 0;
-    for (int c = 0; c < 3; c++)
-        for (int y = 0; y < H; y++) {
-            yp_simulate_line(&fr->line[c * H + y], W, pix);
-            for (int x = 0; x < W; x++) worst = fmax(worst, fabs(pix[x] - fr->ideal[((size_t)c * H + y) * W + x]));
-        }
-    CHECK(worst <= 0.5 + 4 * o.tol + 0.05);
-    yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
-    for (int f = 1; f < yp_anim_frames(an); f++) {
-        for (int i = 0; i < 3 * H; i++) {
-            yp_cmdlist_free(&prev[i]);
-            for (int k = 0; k < fr->line[i].n; k++) yp_cmdlist_push(&prev[i], fr->line[i].c[k]);
-        }
-        int y0, y1;
-        CHECK(yp_anim_apply(an, f, h, sh, &y0, &y1) == HSR_OK);
-        CHECK(y0 == 0 && y1 == H);                 /* a light moved: every line */
-        CHECK(yp_scan(sh, h, &o, y0, y1, fr) == HSR_OK);
-        hsr_ctx *hf = NULL;
-        yp_frame *ff = NULL;
-        CHECK(hsr_scene_build(sc, &hf, &shade) == HSR_OK);
-        free(shade);
-        CHECK(yp_frame_new(W, H, &ff) == HSR_OK);
-        CHECK(yp_scan(sh, hf, &o, 0, H, ff) == HSR_OK);
-        for (int i = 0; i < 3 * H; i++) {
-            CHECK(yp_cmdlist_equal(&ff->line[i], &fr->line[i]));
-            changed += yp_cmdlist_changed_slots(&prev[i], &fr->line[i]);
-            total += fr->line[i].slots;
-        }
-        yp_frame_free(ff); hsr_destroy(hf);
-    }
-    CHECK(changed > 0);
-    CHECK(changed < total / 2);          /* the texture term (most of a line) never changes */
-    for (int i = 0; i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
-    free(prev);
+    CHECK(frame_worst(fr) <= 0.5 + 4 * t.o.tol + 0.05);
     yp_frame_free(plain);
     tanim_close(&t);
+    double worst;
+    textured_run("build/t_tex.anim", 1, 0, &changed, &total, &worst);
+    CHECK(changed > 0);
+    CHECK(changed < total / 2);          /* the texture term (most of a line) never changes */
+}
+
+/* Coherent fitting through yp_scan (docs/yproc.md section 11.1): a slow light (legs of
+ * 400 frames) at tol 4; every frame equals its full rebuild from the same previous frame
+ * and is within 1/2 + 3 tol of the exact shading; fewer slots change than when every
+ * frame is refitted. */
+static void test_coherent_scan_keeps_what_still_fits(void)
+{
+    make_pattern_files();
+    write_file("build/t_slow.anim", "scene t_tex.scene\nframes 10\ntexture pattern 0.3 0.4 1 0.8 0.55 7 8\n"
+               "pointlight 0 0.4 0.3 0.9 falloff 2.5\nwander 0 2718 400 -1.8 -1.3 0.5 1.8 1.3 1.2 from 0 to 9\n");
+    long ch_coh, tot_coh, ch_plain, tot_plain;
+    double w_coh, w_plain;
+    textured_run("build/t_slow.anim", 4, 1, &ch_coh, &tot_coh, &w_coh);
+    textured_run("build/t_slow.anim", 4, 0, &ch_plain, &tot_plain, &w_plain);
+    fprintf(stderr, "  48x36, 9 frames: changed slots %ld coherent (of %ld), %ld plain (of %ld); worst pixel %.2f / %.2f\n",
+            ch_coh, tot_coh, ch_plain, tot_plain, w_coh, w_plain);
+    CHECK(w_coh <= 0.5 + 3 * 4 + 0.05 && w_plain <= 0.5 + 3 * 4 + 0.05);
+    CHECK(ch_coh > 0 && 4 * ch_coh < 3 * ch_plain);
 }
 
 static void test_lod_update_lowers_late_lines_and_raises_when_load_falls(void)
@@ -329,8 +375,7 @@ static void test_lod_loop_removes_overflow_and_restores_quality(void)
                "obj t_plate.obj material plate\nobj t_grid.obj material tile\n");
     write_file("build/t_grid.anim", "scene t_grid.scene\nframes 14\nmove 1 5 0 0 from 6 to 9\n");
     tanim t;
-    CHECK(tanim_open(&t, "build/t_grid.anim", 1));
-    if (!t.fr) { tanim_close(&t); return; }
+    if (!tanim_open(&t, "build/t_grid.anim", 1)) return;
     yp_shader *sh = t.sh;
     hsr_ctx *h = t.h;
     yp_frame *fr = t.fr;
@@ -387,6 +432,7 @@ void suite_yp_tex_lod(void)
     RUN(test_wander_moves_continuously_towards_random_points_in_its_box);
     RUN(test_changed_slots_is_the_lcs_of_the_commands);
     RUN(test_textured_anim_changes_only_the_light_terms);
+    RUN(test_coherent_scan_keeps_what_still_fits);
     RUN(test_lod_update_lowers_late_lines_and_raises_when_load_falls);
     RUN(test_lod_loop_removes_overflow_and_restores_quality);
 }

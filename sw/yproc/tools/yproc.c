@@ -6,7 +6,7 @@
  *   yproc scan SCENE -o OUTDIR [--mode M] [--no-aa] [--shading S] [--frames N]
  *                    [--cmd] [--tol T] [--capacity N] [--expect]
  *   yproc anim ANIMSCENE -o OUTDIR [scan options] [--full] [--lod-loop]
- *                    [--lod-predict] [--monitor-stdin]
+ *                    [--lod-predict] [--monitor-stdin] [--coherent]
  * (scan / anim: docs/yproc.md)
  * Reads the scene (and its OBJ files), applies viewing and perspective,
  * runs the exact incremental HSR and writes the requested outputs.
@@ -30,7 +30,7 @@ static const char USAGE[] =
     "                  [--shading flat|gouraud|phong] [--frames N] [--cmd] [--tol T]\n"
     "                  [--capacity SLOTS] [--expect] [--no-degrade] [--lod L]\n"
     "       yproc anim ANIMSCENE -o OUTDIR [the scan options] [--full] [--lod-loop]\n"
-    "                  [--lod-predict] [--monitor-stdin]\n"
+    "                  [--lod-predict] [--monitor-stdin] [--coherent]\n"
     "       yproc read SCENE -o FILE.json\n"
     "       yproc serve SCENE --dir DIR\n"
     "\n"
@@ -48,7 +48,8 @@ static const char USAGE[] =
     "      --no-degrade    no look-ahead degradation: a line over the capacity overflows\n"
     "      --lod L         every line at level of detail L (0..5; 5 = the options; docs/yproc.md 10)\n"
     "anim  an animation (.anim) through the incremental pipeline, frame by frame\n"
-    "      --full          re-render every frame in full (the baseline)\n"
+    "      --full          re-render every frame in full (the baseline); with --expect also each\n"
+    "                      frame's expect.ppm and ideal.f64 (the exact shading)\n"
     "      --lod-loop      per-line level of detail from the previous frame's Load Monitor\n"
     "                      counts (model of rtl/ctrl/de_load_monitor.sv; implies --no-degrade)\n"
     "      --lod-predict   the loop, and before a frame is emitted every line over the capacity\n"
@@ -58,6 +59,8 @@ static const char USAGE[] =
     "      --monitor-stdin the loop reads the monitor's record from stdin instead of its model:\n"
     "                      after each frame, 'monitor F' on stdout, then one line on stdin:\n"
     "                      F, H issued counts, H late flags (diffengine anim --lod-loop --rtl)\n"
+    "      --coherent      keep the previous frame's colour functions where they still meet the\n"
+    "                      tolerance, refit only the failing spans (docs/yproc.md 11)\n"
     "read  the scene and its OBJ/MTL files as read, as JSON (schema hsr-scene-1, docs/hsr.md):\n"
     "      what the Python reference renderer draws, so every format has one reader\n"
     "serve the scene held for the viewer (docs/viewer.md): one request a line on stdin (pick,\n"

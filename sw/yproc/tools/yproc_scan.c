@@ -1,6 +1,7 @@
 /* yproc_scan.c - `yproc scan` and `yproc anim` (docs/yproc.md): scene ->
  * HSR -> y-processor -> r/g/b command streams, stats.json, summary line. */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +27,7 @@ typedef struct opts {
     yp_options yo;
     int frames, cmd, expect, full, width, height, mode_given;
     int lod_loop;        /* anim: per-line level of detail from the Load Monitor model */
+    int coherent;        /* anim: temporally coherent fitting (yp_options.prev) */
     int lod_predict;     /* anim: and each line checked against the capacity before it is emitted */
     int monitor_stdin;   /* anim: the monitor's record per frame from stdin (the Verilated controller) */
     int lod_all;         /* scan: every line at this level of detail (-1: the options) */
@@ -48,6 +50,7 @@ static int parse(int argc, char **argv, opts *o)
         else if (!strcmp(a, "--lod-loop")) { o->lod_loop = 1; o->yo.no_degrade = 1; }
         else if (!strcmp(a, "--lod-predict")) { o->lod_loop = o->lod_predict = 1; o->yo.no_degrade = 1; }
         else if (!strcmp(a, "--monitor-stdin")) o->monitor_stdin = 1;
+        else if (!strcmp(a, "--coherent")) o->coherent = o->yo.coherent = 1;
         else if (strcmp(a, "-o") && strcmp(a, "--mode") && strcmp(a, "--shading") && strcmp(a, "--frames")
                  && strcmp(a, "--tol") && strcmp(a, "--capacity") && strcmp(a, "--lod"))
             return yproc_usage_error("unknown option", a);
@@ -368,6 +371,46 @@ static int lod_stats(FILE *js, const yp_frame *fr, yp_lod *lod, int cap, int fra
     return 0;
 }
 
+/* the frame's worst pixel: max over colours and pixels of |the array's 12-bit value
+ * (yp_simulate_line) - the exact shading (fr->ideal)|, pixel units */
+static double frame_max_err(const yp_frame *fr)
+{
+    int W = fr->width, H = fr->height;
+    double mx = 0;
+    uint16_t *pix = malloc(sizeof(uint16_t) * (size_t)W);
+    if (!pix) return -1;
+    for (int c = 0; c < 3; c++)
+        for (int y = 0; y < H; y++) {
+            yp_simulate_line(&fr->line[c * H + y], W, pix);
+            const double *id = &fr->ideal[((size_t)c * H + y) * W];
+            for (int x = 0; x < W; x++) if (fabs(pix[x] - id[x]) > mx) mx = fabs(pix[x] - id[x]);
+        }
+    free(pix);
+    return mx;
+}
+
+static int dcmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* how far the exact shading moved since the previous frame: median, 90th percentile and
+ * max of |ideal - prev| over the pixels (and colours) whose exact value changed; prev then
+ * takes the frame's values.  tmp: room for 3 W H doubles */
+static void exact_change(const yp_frame *fr, double *prev, double *tmp, FILE *js)
+{
+    size_t n = 3 * (size_t)fr->width * (size_t)fr->height, k = 0;
+    for (size_t i = 0; i < n; i++) {
+        double d = fabs(fr->ideal[i] - prev[i]);
+        if (d > 0) tmp[k++] = d;
+        prev[i] = fr->ideal[i];
+    }
+    qsort(tmp, k, sizeof *tmp, dcmp);
+    fprintf(js, ", \"exact_change\": {\"pixels\": %zu, \"median\": %.4f, \"p90\": %.4f, \"max\": %.4f}", k,
+            k ? tmp[k / 2] : 0.0, k ? tmp[(size_t)(0.9 * (double)(k - 1))] : 0.0, k ? tmp[k - 1] : 0.0);
+}
+
 static void tess_json(FILE *js, yp_anim *an, int coarsened)
 {
     yp_tess *t = yp_anim_tess(an);
@@ -392,10 +435,12 @@ static int anim_main(opts *o)
     int rc = 0, F = yp_anim_frames(an), W = sc->width, H = sc->height;
     yp_cmdlist *prev = calloc(3 * (size_t)H, sizeof(yp_cmdlist));
     int *chslots = calloc(3 * (size_t)H, sizeof(int));
+    int *chcmds = calloc(3 * (size_t)H, sizeof(int));
+    double *ideal_prev = malloc(sizeof(double) * 3 * (size_t)W * (size_t)H), *ideal_tmp = malloc(sizeof(double) * 3 * (size_t)W * (size_t)H);
     unsigned char *lod_prev = malloc((size_t)H + 1);
     char *changed[3];
     for (int c = 0; c < 3; c++) changed[c] = calloc((size_t)H, 1);
-    if (!prev || !chslots || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
+    if (!prev || !chslots || !chcmds || !ideal_prev || !ideal_tmp || !lod_prev || !changed[0] || !changed[1] || !changed[2]) { rc = 1; goto out; }
     memset(lod_prev, YP_LOD_MAX, (size_t)H);
     yp_lod *lod = NULL;
     if ((st = yp_anim_apply(an, 0, NULL, NULL, NULL, NULL)) != HSR_OK
@@ -415,13 +460,16 @@ static int anim_main(opts *o)
     double t1 = now_ms();
     if (mkdir_p(o->out)) { rc = 1; goto out; }
     snprintf(p, sizeof p, "%s/frame000", o->out);
-    if (mkdir_p(p) || write_streams(fr, p, o->cmd) || copy_lines(prev, fr)) { rc = 1; goto out; }
+    if (mkdir_p(p) || write_streams(fr, p, o->cmd) || (o->expect && write_expect(fr, p)) || copy_lines(prev, fr)) { rc = 1; goto out; }
+    memcpy(ideal_prev, fr->ideal, sizeof(double) * 3 * (size_t)W * (size_t)H);
     snprintf(p, sizeof p, "%s/anim_stats.json", o->out);
     FILE *js = fopen(p, "w");
     if (!js) { rc = 1; goto out; }
     fprintf(js, "{\"format\": \"yproc-anim-1\", \"anim\": \"%s\", \"frames\": %d, \"width\": %d, \"height\": %d, "
-                "\"capacity\": %d, \"lod_loop\": %d, \"lod_predict\": %d, \"no_degrade\": %d,\n \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f",
-            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->lod_predict, o->yo.no_degrade, t1 - t0);
+                "\"capacity\": %d, \"lod_loop\": %d, \"lod_predict\": %d, \"no_degrade\": %d, \"coherent\": %d, \"tol\": %g,\n"
+                " \"frame\": [\n  {\"frame\": 0, \"full_ms\": %.3f, \"max_abs_err\": %.4f",
+            o->in, F, W, H, o->yo.capacity, o->lod_loop, o->lod_predict, o->yo.no_degrade, o->coherent, o->yo.tol, t1 - t0,
+            frame_max_err(fr));
     tess_json(js, an, coarsened);
     for (int k = 0; k < yp_tess_count(yp_anim_tess(an)); k++) {
         /* faces of each version (the scene's obj statements of the clustered meshes) */
@@ -449,6 +497,7 @@ static int anim_main(opts *o)
         for (int y = 0; lod && y < H; y++)
             if (lod_prev[y] != yp_lod_levels(lod)[y]) { if (y0 == y1) { y0 = y; y1 = y + 1; } if (y < y0) y0 = y; if (y + 1 > y1) y1 = y + 1; }
         if (lod) memcpy(lod_prev, yp_lod_levels(lod), (size_t)H);
+        if (o->coherent) o->yo.prev = prev;          /* the frame before this one */
         double am = now_ms();
         if (st == HSR_OK) st = yp_scan(sh, h, &o->yo, y0, y1, fr);
         /* the y-processor's own check: lines over the capacity lowered before they are emitted */
@@ -465,10 +514,11 @@ static int anim_main(opts *o)
                 changed[c][y] = y >= y0 && y < y1 && !yp_cmdlist_equal(&fr->line[c * H + y], &prev[c * H + y]);
                 nch[c] += changed[c][y];
                 /* instructions of the line that the delta really changes (LCS of the commands) */
-                chslots[c * H + y] = changed[c][y] ? yp_cmdlist_changed_slots(&prev[c * H + y], &fr->line[c * H + y]) : 0;
+                chcmds[c * H + y] = 0;
+                chslots[c * H + y] = changed[c][y] ? yp_cmdlist_changed(&prev[c * H + y], &fr->line[c * H + y], &chcmds[c * H + y]) : 0;
             }
         snprintf(p, sizeof p, "%s/frame%03d.delta", o->out, f);
-        if (write_delta(p, f, fr, changed) || copy_lines(prev, fr)) { rc = 1; break; }
+        if (write_delta(p, f, fr, changed)) { rc = 1; break; }
         double a2 = now_ms();
         /* the same frame from scratch: HSR rebuild + every line */
         double b0 = now_ms();
@@ -486,20 +536,26 @@ static int anim_main(opts *o)
         degraded_lines += deg;
         if (st == HSR_OK && o->full) {
             snprintf(p, sizeof p, "%s/frame%03d", o->out, f);
-            if (mkdir_p(p) || write_streams(ff, p, o->cmd)) rc = 1;
+            if (mkdir_p(p) || write_streams(ff, p, o->cmd) || (o->expect && write_expect(ff, p))) rc = 1;
         }
         yp_frame_free(ff); hsr_destroy(hf);
-        if (st != HSR_OK) { rc = 1; break; }
+        if (st != HSR_OK || copy_lines(prev, fr)) { rc = 1; break; }
         sum_inc += a1 - a0; sum_full += b1 - b0; sum_changed += nch[0] + nch[1] + nch[2];
         sum_inc_scan += a1 - am; sum_full_scan += b1 - bm;
         fprintf(js, ",\n  {\"frame\": %d, \"rescanned_lines\": [%d, %d], \"changed_lines\": [%d, %d, %d], "
                     "\"incremental_ms\": %.3f, \"incremental_hsr_ms\": %.3f, \"incremental_scan_ms\": %.3f, "
                     "\"delta_write_ms\": %.3f, \"full_ms\": %.3f, \"full_hsr_ms\": %.3f, \"full_scan_ms\": %.3f, "
-                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d",
-                f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am, a2 - a1, b1 - b0, bm - b0, b1 - bm, diff, deg);
+                    "\"lines_differing_from_full\": %d, \"lines_degraded\": %d, \"max_abs_err\": %.4f",
+                f, y0, y1, nch[0], nch[1], nch[2], a1 - a0, am - a0, a1 - am, a2 - a1, b1 - b0, bm - b0, b1 - bm, diff, deg,
+                frame_max_err(fr));
         fprintf(js, ", \"changed_slots\": [");
         for (int c = 0; c < 3; c++)
             for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chslots[c * H + y], y == H - 1 ? "]" : "");
+        fprintf(js, "]");
+        exact_change(fr, ideal_prev, ideal_tmp, js);
+        fprintf(js, ", \"changed_cmds\": [");
+        for (int c = 0; c < 3; c++)
+            for (int y = 0; y < H; y++) fprintf(js, "%s%s%d%s", y ? "" : c ? ", [" : "[", y ? ", " : "", chcmds[c * H + y], y == H - 1 ? "]" : "");
         fprintf(js, "]");
         tess_json(js, an, coarsened);
         if (lod_stats(js, fr, lod, o->yo.capacity, f, o->monitor_stdin, lowered)) { rc = 1; break; }
@@ -522,7 +578,7 @@ static int anim_main(opts *o)
     }
 out:
     if (prev) for (int i = 0; i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
-    free(prev); free(chslots); free(lod_prev); yp_lod_free(lod);
+    free(prev); free(chslots); free(chcmds); free(ideal_prev); free(ideal_tmp); free(lod_prev); yp_lod_free(lod);
     for (int c = 0; c < 3; c++) free(changed[c]);
     yp_frame_free(fr); hsr_destroy(h); yp_shader_free(sh); yp_anim_free(an);
     return rc;
