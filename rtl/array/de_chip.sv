@@ -11,9 +11,9 @@
 // Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
 // PE's place is taken by a register on the bus and on the pixel chain (the source's
 // bypass is a wire; registered here so that the chip's clock does not depend on how many
-// PEs are bypassed in a row) and the PE is held in reset (no pixel, zero outputs, an
-// all-zero observation word); relative addressing makes the remaining PEs a smaller
-// array, one clock later per bypassed PE.
+// PEs are bypassed in a row; on the bus it is the PE's own output register) and the rest
+// of the PE is held in reset (no pixel, an all-zero observation word); relative
+// addressing makes the remaining PEs a smaller array, one clock later per bypassed PE.
 // Observation (7.4.5): a second serial register that loads each PE's controller outputs
 // (flags, stage-1 identifier, control pipeline) on obs_load and shifts them out.
 `default_nettype none
@@ -60,9 +60,9 @@ module de_chip
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
-// pass through bypass muxes and OR gates only (the PEs' own outputs and the bypass
-// registers are registered); the bus path crosses one mux, the pixel chain the OR gates
-// of the PEs in use since the last bypass register.
+// pass through no logic but a gated OR (the PEs' own outputs and the pixel bypass
+// registers are registered); the bus path crosses none, the pixel chain one OR of its
+// sources, each gated by a registered reach bit.
 /* verilator lint_off DECLFILENAME */
 module de_chip_core
   import de_pkg::*;
@@ -98,6 +98,8 @@ module de_chip_core
   logic [NumPe:0][DataW-1:0] bus_data;
   logic [NumPe:0][PixW-1:0]  pix_or;
   logic [NumPe:0]            pixv_or;
+  logic [NumPe-1:0][PixW-1:0] src_pix;  // what PE i puts on the pixel chain
+  logic [NumPe-1:0]           src_pixv;
   logic [NumPe-1:0]          coll;
   logic [NumPe-1:0]          byp_d, byp_q;
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
@@ -117,14 +119,12 @@ module de_chip_core
     logic [DbgW-1:0]  pe_dbg;
     /* verilator lint_on UNUSEDSIGNAL */
 
-    // A bypassed PE is held in reset: its outputs are then zero, so the chain can OR
-    // them with the bypass register (below) instead of muxing with a select bit.
-    logic pe_rst;
-    assign pe_rst = rst_i || byp_q[i];
-
+    // A bypassed PE is its own bus register: it passes id and data on one clock later
+    // and holds the rest of its state in reset (de_pe bypass_i).
     de_pe #(.CarryBug(CarryBug)) u_pe (
       .clk_i,
-      .rst_i      (pe_rst),
+      .rst_i,
+      .bypass_i   (byp_q[i]),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .id_o       (pe_id),
@@ -135,37 +135,69 @@ module de_chip_core
     );
 
     // A bypassed PE is a register (registered bypass): the bus takes one clock per PE
-    // whatever the configuration, so no combinational path runs through two PEs. The
-    // bypass register holds zero while its PE is in use, and the PE's outputs are zero
-    // while it is bypassed (held in reset), so the next PE sees their OR: no select bit
-    // on the bus path. The pixel chain takes a register there too, so the pixels of the
-    // PEs in front catch up with the bus: pixels stay in raster order with no gap, one
-    // clock later per bypassed PE (docs/array.md). A faulty PE (test parameter) garbles
-    // what it passes on while it is in use.
-    logic [IdW-1:0]   byp_id_q;
-    logic [DataW-1:0] byp_data_q;
+    // whatever the configuration, so no combinational path runs through two PEs. On the
+    // bus that register is the PE's own output register (bypass_i), so the next PE's
+    // input comes straight from a flip-flop. The pixel chain takes a register here, so
+    // the pixels of the PEs in front catch up with the bus: pixels stay in raster order
+    // with no gap, one clock later per bypassed PE (docs/array.md). A faulty PE (test
+    // parameter) garbles what it passes on while it is in use.
     logic             byp_pixv_q;
     logic [PixW-1:0]  byp_pix_q;
     always_ff @(posedge clk_i) begin
       if (rst_i || !byp_q[i]) begin
-        byp_id_q   <= '0;
-        byp_data_q <= '0;
         byp_pixv_q <= 1'b0;
         byp_pix_q  <= '0;
       end else begin
-        byp_id_q   <= bus_id[i];
-        byp_data_q <= bus_data[i];
         byp_pixv_q <= pixv_or[i];
         byp_pix_q  <= pix_or[i];
       end
     end
-    assign bus_id[i+1]   = byp_id_q | pe_id;
-    assign bus_data[i+1] = byp_data_q | ((FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data);
-    // At most one PE of the whole array drives a pixel in a cycle, so OR is a mux.
-    assign pix_or[i+1]  = byp_q[i] ? byp_pix_q  : pix_or[i]  | (pe_pixv ? pe_pix : '0);
-    assign pixv_or[i+1] = byp_q[i] ? byp_pixv_q : pixv_or[i] | pe_pixv;
-    assign coll[i]      = pixv_or[i] && pe_pixv && !byp_q[i];
-    assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgPaLsb:DbgId1Lsb], pe_dbg[DbgAccc3Lsb +: DbgCtlW]};
+    assign bus_id[i+1]   = pe_id;
+    assign bus_data[i+1] = (FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data;
+    // The pixel chain at PE i (below): a bypassed PE's register replaces everything in
+    // front of it, a PE in use adds its pixel. At most one PE of the whole array drives a
+    // pixel in a cycle, so OR is a mux.
+    assign src_pix[i]  = byp_q[i] ? byp_pix_q  : (pe_pixv ? pe_pix : '0);
+    assign src_pixv[i] = byp_q[i] ? byp_pixv_q : pe_pixv;
+    assign coll[i]     = pixv_or[i] && pe_pixv && !byp_q[i];
+    // A bypassed PE's stage-1 identifier register carries the passing slots; the
+    // observation word shows zero there, as it did when the PE's id_q was in reset: from
+    // the clock after the bypass bit is set to the clock after it is cleared (byp_id0_q).
+    logic byp_id0_q;
+    always_ff @(posedge clk_i) begin
+      if (rst_i) byp_id0_q <= 1'b0;
+      else byp_id0_q <= byp_q[i];
+    end
+    assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgPaLsb:DbgActLsb],
+                                       byp_id0_q ? '0 : pe_dbg[DbgId1Lsb +: IdW],
+                                       pe_dbg[DbgAccc3Lsb +: DbgCtlW]};
+  end
+
+  // The pixel chain, pix_or[n+1] = byp_q[n] ? byp_pix_q[n] : pix_or[n] | pixel of PE n,
+  // is not built as a chain of NumPe OR gates (static timing would see them all in one
+  // path, whatever the configuration) but as an OR of its sources each gated by a
+  // registered reach bit: reach_q[n][s] = source s (0: the chip input, k+1: PE k or its
+  // bypass register) gets to position n, i.e. no PE in s..n-1 is bypassed. reach_q
+  // follows byp_q (both load from byp_d), so every cycle gives the chain's values.
+  logic [NumPe:1][NumPe:0] reach_d, reach_q;
+  always_comb begin
+    reach_d = '0;
+    for (int n = 1; n <= NumPe; n++) begin
+      reach_d[n][n] = 1'b1;  // PE n-1 itself: its pixel or its bypass register
+      for (int s = n - 1; s >= 0; s--) begin
+        reach_d[n][s] = reach_d[n][s+1] && !byp_d[s];
+      end
+    end
+  end
+  for (genvar n = 1; n <= NumPe; n++) begin : g_pix_or
+    always_comb begin
+      pix_or[n]  = reach_q[n][0] ? pix_or[0] : '0;
+      pixv_or[n] = reach_q[n][0] && pixv_or[0];
+      for (int s = 1; s <= n; s++) begin
+        pix_or[n]  = pix_or[n] | (reach_q[n][s] ? src_pix[s-1] : '0);
+        pixv_or[n] = pixv_or[n] | (reach_q[n][s] && src_pixv[s-1]);
+      end
+    end
   end
 
   // Configuration shift register: enters at PE 0, leaves after PE NumPe-1.
@@ -190,11 +222,13 @@ module de_chip_core
   // Configuration and observation registers.
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
-      byp_q <= '0;
-      obs_q <= '0;
+      byp_q   <= '0;
+      reach_q <= '1;   // no PE bypassed
+      obs_q   <= '0;
     end else begin
-      byp_q <= byp_d;
-      obs_q <= obs_d;
+      byp_q   <= byp_d;
+      reach_q <= reach_d;
+      obs_q   <= obs_d;
     end
   end
 

@@ -21,6 +21,9 @@ module de_pe
 ) (
   input  logic             clk_i,
   input  logic             rst_i,        // synchronous, active high
+  // Static (a chip's configuration): the PE is replaced by a register. id_o/data_o carry
+  // id_i/data_i one clock later and every other register is held in reset.
+  input  logic             bypass_i = 1'b0,
   input  logic [IdW-1:0]   id_i,         // identifier of the slot at stage 0
   input  logic [DataW-1:0] data_i,       // skewed: [j*12 +: 12] = block j of stage j's slot
   output logic [IdW-1:0]   id_o,         // registered, to the next PE
@@ -61,6 +64,16 @@ module de_pe
   logic accen3_d, accen3_q, accc3_d, accc3_q;  // ACC: write D block 2 / its carry in
   logic pixv_d, pixv_q;
   logic [PixW-1:0] pix_d, pix_q;
+  // Timing only (not architectural state, so not in dbg_o): act_eff for the next cycle
+  // when its stage-1 block 1 is zero / non-zero, decided one cycle early (docs/xproc.md 3).
+  logic aez_d, aez_q, aenz_d, aenz_q;
+  // Timing only, likewise: the stage-1 slot is a Dis / an Eval0 whose X was 0.
+  logic disx_d, disx_q, e0x_d, e0x_q;
+  // Timing only, likewise: the SRC and DST operands of the slots in stages 1 and 2,
+  // selected a cycle early from the next values of the register blocks they will read.
+  logic [BlkW-1:0] src1_d, src1_q, dst1_d, dst1_q, src2_d, src2_q, dst2_d, dst2_q;
+  // Timing only, likewise: the register write of the slot in stage 1 / 2 (wr1, wr2).
+  logic wr1_d, wr1_q, wr2_d, wr2_q;
 
   // ---- inputs and decode -------------------------------------------------------------
   logic [NumBlk-1:0][BlkW-1:0] in_blk;
@@ -80,85 +93,119 @@ module de_pe
   localparam bit Bug = (CarryBug == 1);
 
   // ---- stage 1 address decision (needed first: it sets act for stage 0) --------------
-  logic per1, fire_per1, fire_rng1, fire1, act_eff;
+  // An address slot fires when, periodic, its countdown (block 1) is 0, or, range, X was
+  // 0 (xz1_q) and dX (block 1) is not: fire1 = id1.addr && (per1 ? z1 : xz1_q && !z1).
+  logic z1, per1, act_eff;
+  // The zero test in two kept halves of 6 bits, so that act_eff is one LUT4 of both halves
+  // and aez_q/aenz_q rather than one more level behind a 12-bit test.
+  (* keep *) logic z1_lo, z1_hi;
+  assign z1_lo     = (in_blk[1][BlkW/2-1:0] == '0);
+  assign z1_hi     = (in_blk[1][BlkW-1:BlkW/2] == '0);
+  assign z1        = z1_lo && z1_hi;
   assign per1      = id1.addr && (id1.sub == SubPeriodic);
-  assign fire_per1 = (in_blk[1] == '0);                 // countdown reached 0
-  assign fire_rng1 = xz1_q && (in_blk[1] != '0);        // X was 0 and dX > 0
-  assign fire1     = id1.addr && (per1 ? fire_per1 : fire_rng1);
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
-  // sees that slot's decision at once; later slots of the command see the act register.
-  assign act_eff   = id1.addr ? fire1 : act_q;
+  // sees that slot's decision at once; later slots of the command see the act register:
+  // act_eff = id1.addr ? fire1 : act_q. Everything in it but the zero test of block 1 is
+  // known a cycle earlier, so both outcomes are registered then (aez_q, aenz_q) and only
+  // the zero test and one mux stand in front of stage 0 (the PE's critical path).
+  assign act_eff   = z1 ? aez_q : aenz_q;
 
   // ---- stage 0: identifier + block 0 ---------------------------------------------------
-  logic ev0, st0, rng0, xz0, prot0, active0, wr0;
-  logic [BlkW-1:0] v0, out0;
-  logic [BlkW:0] s0;
+  logic ev0, st0, rng0, xz0, pv0, prot0, active0, wr0;
+  logic [BlkW-1:0] src0, out0;
+  logic [BlkW:0] sp0, sn0, s0;
   assign ev0     = id0.data && !id0.set;
   assign st0     = id0.data && id0.set;
   assign rng0    = id0.addr && (id0.sub != SubPeriodic);
   assign xz0     = (in_blk[0] == '0);
-  // Protection is decided once per slot, here, and travels with it down the pipeline.
-  assign prot0   = ev0 && act_eff && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
+  // Protection is decided once per slot, here, and travels with it down the pipeline;
+  // pv0 is the part that does not depend on act_eff.
+  assign pv0     = ev0 && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
+  assign prot0   = act_eff && pv0;
   assign active0 = ev0 && act_eff;
-  assign v0      = prot0 ? reg_blk(id0.dst, a_q[0], b_q[0], c_q[0]) : in_blk[0];
-  assign s0      = {1'b0, v0} + {1'b0, reg_blk(id0.src, a_q[0], b_q[0], c_q[0])};
-  assign wr0     = (ev0 || st0) && act_eff && (id0.dst != RegNone);
+  assign src0    = reg_blk(id0.src, a_q[0], b_q[0], c_q[0]);
+  // v0 + SRC0 with v0 = prot0 ? DST0 : in0: both sums are formed while act_eff is still
+  // being decided and pv0 picks one after the adders (carry select on the operand).
+  assign sp0     = {1'b0, reg_blk(id0.dst, a_q[0], b_q[0], c_q[0])} + {1'b0, src0};
+  assign sn0     = {1'b0, in_blk[0]} + {1'b0, src0};
+  assign s0      = pv0 ? sp0 : sn0;
+  // A protected slot writes DST with DST's own value: no write. So a write is in0 only.
+  assign wr0     = (ev0 || st0) && act_eff && !pv0 && (id0.dst != RegNone);
 
+  // In bypass, every block passes unchanged (live = 0); the rest of the PE is in reset,
+  // but not yet in the first cycle of the bypass, hence the explicit term.
+  logic live;
+  assign live = !bypass_i;
+
+  // out0 = sum0 ? s0 : pass0. The select and the pass value are kept as nets of their
+  // own, so that the last LUT in front of out_q[0] has the five inputs sum0, pv0, sp0,
+  // sn0, pass0 (one PFUMX) rather than a 7-input function of the decisions.
+  (* keep *) logic sum0;
+  (* keep *) logic [BlkW-1:0] pass0;
+  assign sum0 = active0 && live;
   always_comb begin
-    out0 = in_blk[0];
-    if (rng0) begin
+    pass0 = in_blk[0];
+    if (rng0 && live) begin
       // Relative addressing: count X down to 0 and keep it there.
-      out0 = xz0 ? '0 : in_blk[0] - BlkW'(1);
-    end
-    if (active0) begin
-      out0 = s0[BlkW-1:0];
+      pass0 = xz0 ? '0 : in_blk[0] - BlkW'(1);
     end
   end
+  assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
 
   // ---- stage 1: block 1 ------------------------------------------------------------------
-  logic ev1, st1, active1, wr1, dis1, e0_1, e0en1;
-  logic [BlkW-1:0] v1, out1;
-  logic [BlkW:0] s1;
+  logic ev1, active1, wr1, dis1, e0_1, e0en1;
+  logic [BlkW-1:0] src1, out1;
+  logic [BlkW:0] sp1, sn1, s1;
   assign ev1     = id1.data && !id1.set;
-  assign st1     = id1.data && id1.set;
   assign active1 = ev1 && act1_q;
-  assign v1      = prot1_q ? reg_blk(id1.dst, a_q[1], b_q[1], c_q[1]) : in_blk[1];
-  assign s1      = {1'b0, v1} + {1'b0, reg_blk(id1.src, a_q[1], b_q[1], c_q[1])}
-                 + blk_carry_in(c1_q, 1, Bug);
-  assign wr1     = (ev1 || st1) && act1_q && (id1.dst != RegNone);
-  assign dis1    = id1.addr && (id1.sub == SubDis) && fire1;
-  assign e0_1    = id1.addr && (id1.sub == SubEval0) && fire1;
+  // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the adder.
+  assign src1    = src1_q;
+  // As in stage 0: both operand sums, prot1_q picks one after the adders.
+  assign sp1     = {1'b0, dst1_q} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
+  assign sn1     = {1'b0, in_blk[1]} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
+  assign s1      = prot1_q ? sp1 : sn1;
+  // = (ev1 || st1) && act1_q && !prot1_q && (id1.dst != RegNone), i.e. wr0 a cycle ago.
+  assign wr1     = wr1_q;
+  // Dis and Eval0 are range addresses: fire = X was 0 and dX is not; the slot's kind and
+  // X == 0 were registered in its stage 0 (disx_q, e0x_q), the zero test of dX is now.
+  assign dis1    = disx_q && !z1;
+  assign e0_1    = e0x_q && !z1;
   assign e0en1   = e0_1 && !lock_q && !dis_q;
 
-  always_comb begin
-    out1 = in_blk[1];
-    if (per1) begin
-      // Periodic: reload the countdown with P-1 from out_q block 0, which still holds
-      // the period this slot passed on unchanged one cycle ago (no extra register).
-      out1 = fire_per1 ? out_q[0] - BlkW'(1) : in_blk[1] - BlkW'(1);
-    end else if (id1.addr && fire_rng1) begin
-      out1 = in_blk[1] - BlkW'(1);
-    end
-    if (active1) begin
-      out1 = s1[BlkW-1:0];
-    end
-  end
+  // out1 = sum1 ? s1 : pass1, select and pass value kept as nets, as in stage 0.
+  // An address slot decrements block 1 (the countdown, or dX when X was 0) unless it is
+  // 0; then a periodic slot reloads P-1 from out_q block 0, which still holds the period
+  // this slot passed on unchanged one cycle ago (no extra register), and any other slot
+  // passes the 0. The decrement subtracts dec1 (not a mux after it): one carry chain.
+  (* keep *) logic sum1;
+  (* keep *) logic [BlkW-1:0] pass1;
+  logic dec1;
+  logic [BlkW-1:0] q1, d1;
+  assign sum1  = active1 && live;
+  assign dec1  = live && (per1 || (id1.addr && xz1_q));
+  assign d1    = in_blk[1] - BlkW'(dec1);
+  assign q1    = (per1 && live) ? out_q[0] - BlkW'(1) : '0;
+  assign pass1 = z1 ? q1 : d1;
+  assign out1  = sum1 ? s1[BlkW-1:0] : pass1;
 
   // ---- stage 2: block 2 ------------------------------------------------------------------
-  logic ev2, st2, active2, wr2;
-  logic [BlkW-1:0] v2, out2;
+  logic ev2, active2, wr2;
+  logic [BlkW-1:0] src2, out2;
   // The carry out of block 2 (bit 35) is dropped: arithmetic wraps modulo 2^36.
   /* verilator lint_off UNUSEDSIGNAL */
-  logic [BlkW:0] s2;
+  logic [BlkW:0] sp2, sn2, s2;
   /* verilator lint_on UNUSEDSIGNAL */
   assign ev2     = id2.data && !id2.set;
-  assign st2     = id2.data && id2.set;
   assign active2 = ev2 && act2_q;
-  assign v2      = prot2_q ? reg_blk(id2.dst, a_q[2], b_q[2], c_q[2]) : in_blk[2];
-  assign s2      = {1'b0, v2} + {1'b0, reg_blk(id2.src, a_q[2], b_q[2], c_q[2])}
-                 + blk_carry_in(c2_q, 2, Bug);
-  assign wr2     = (ev2 || st2) && act2_q && (id2.dst != RegNone);
-  assign out2    = active2 ? s2[BlkW-1:0] : in_blk[2];
+  // = reg_blk(id2.src, a_q[2], b_q[2], c_q[2]), registered (src2_q), as in stage 1.
+  assign src2    = src2_q;
+  // As in stage 0: both operand sums, prot2_q picks one after the adders.
+  assign sp2     = {1'b0, dst2_q} + {1'b0, src2} + blk_carry_in(c2_q, 2, Bug);
+  assign sn2     = {1'b0, in_blk[2]} + {1'b0, src2} + blk_carry_in(c2_q, 2, Bug);
+  assign s2      = prot2_q ? sp2 : sn2;
+  // = (ev2 || st2) && act2_q && !prot2_q && (id2.dst != RegNone), i.e. wr1 a cycle ago.
+  assign wr2     = wr2_q;
+  assign out2    = (active2 && live) ? s2[BlkW-1:0] : in_blk[2];
 
   // ---- accumulator: ACC decided in its stage 1, D block j written in stage j+1 ----------
   // The decision waits one cycle because Acc_mode needs the sign of A (bit 35), which is
@@ -172,7 +219,7 @@ module de_pe
   always_comb begin
     a2_sign_next = a_q[2][BlkW-1];
     if (wr2 && (id2.dst == RegA)) begin
-      a2_sign_next = v2[BlkW-1];
+      a2_sign_next = in_blk[2][BlkW-1];
     end
     if (id2.refresh) begin
       a2_sign_next = 1'b0;
@@ -209,26 +256,27 @@ module de_pe
     b_d = b_q;
     c_d = c_q;
     d_d = d_next;
-    // Block j of a data slot is written in its stage j (only one slot per stage).
+    // Block j of a data slot is written in its stage j (only one slot per stage); the
+    // value written is the input block (wr* is off for a protected slot, see wr0).
     if (wr0) begin
       case (id0.dst)
-        RegA:    a_d[0] = v0;
-        RegB:    b_d[0] = v0;
-        default: c_d[0] = v0;
+        RegA:    a_d[0] = in_blk[0];
+        RegB:    b_d[0] = in_blk[0];
+        default: c_d[0] = in_blk[0];
       endcase
     end
     if (wr1) begin
       case (id1.dst)
-        RegA:    a_d[1] = v1;
-        RegB:    b_d[1] = v1;
-        default: c_d[1] = v1;
+        RegA:    a_d[1] = in_blk[1];
+        RegB:    b_d[1] = in_blk[1];
+        default: c_d[1] = in_blk[1];
       endcase
     end
     if (wr2) begin
       case (id2.dst)
-        RegA:    a_d[2] = v2;
-        RegB:    b_d[2] = v2;
-        default: c_d[2] = v2;
+        RegA:    a_d[2] = in_blk[2];
+        RegB:    b_d[2] = in_blk[2];
+        default: c_d[2] = in_blk[2];
       endcase
     end
     // A Refresh clears block j of A-D in its stage j; the clear wins over any write.
@@ -304,6 +352,20 @@ module de_pe
 
   // Only data and ACC slots keep act; every other slot ends the command (isa.md sec. 5).
   assign act_d = (id0.data || id0.acc) && act_eff;
+  // Next cycle's act_eff for either outcome of its zero test (the address decision of
+  // the slot now in stage 0, else act_d).
+  assign aez_d  = id0.addr ? (id0.sub == SubPeriodic) : act_d;
+  assign aenz_d = id0.addr ? xz1_d : act_d;
+  assign disx_d = xz1_d && (id0.sub == SubDis);
+  assign e0x_d  = xz1_d && (id0.sub == SubEval0);
+  // wr1/wr2 are wr0/wr1 one cycle on; the slot in stage 0 (1) reads block 1 (2) next
+  // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
+  assign wr1_d  = wr0;
+  assign wr2_d  = wr1;
+  assign src1_d = reg_blk(id0.src, a_d[1], b_d[1], c_d[1]);
+  assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
+  assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
+  assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
 
   // ---- pipeline next state ----------------------------------------------------------------
   assign id_d     = id_i;
@@ -312,7 +374,7 @@ module de_pe
   assign xz1_d    = rng0 && xz0;
   assign act1_d   = act_eff;
   assign prot1_d  = prot0;
-  assign c1_d     = active0 && s0[BlkW];
+  assign c1_d     = sum0 && s0[BlkW];     // = active0 && s0[BlkW] (in bypass c1_q is held in reset)
   assign act2_d   = act1_q;
   assign prot2_d  = prot1_q;
   assign c2_d     = active1 && s1[BlkW];
@@ -331,8 +393,22 @@ module de_pe
   // Synchronous reset: it maps onto the FPGA flops' local set/reset with no
   // recovery/removal timing to close, and it makes reset just another clock cycle,
   // exactly as the structural model treats it.
+  // The bus registers: the PE's own output, or in bypass its input one clock later. The
+  // bypass register of a chip is thus this register, and the next PE's input is a
+  // flip-flop with no OR or mux behind it (docs/fpga.md, section 6.3).
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
+      id_q  <= '0;
+      out_q <= '0;
+    end else begin
+      id_q  <= id_d;
+      out_q <= out_d;
+    end
+  end
+
+  // Everything else; a bypassed PE holds it in reset (no pixel, an all-zero state).
+  always_ff @(posedge clk_i) begin
+    if (rst_i || bypass_i) begin
       a_q      <= '0;
       b_q      <= '0;
       c_q      <= '0;
@@ -344,8 +420,6 @@ module de_pe
       lock_q   <= 1'b0;
       accm_q   <= 1'b0;
       act_q    <= 1'b0;
-      id_q     <= '0;
-      out_q    <= '0;
       id2_q    <= '0;
       xz1_q    <= 1'b0;
       act1_q   <= 1'b0;
@@ -361,6 +435,16 @@ module de_pe
       accc3_q  <= 1'b0;
       pixv_q   <= 1'b0;
       pix_q    <= '0;
+      aez_q    <= 1'b0;
+      aenz_q   <= 1'b0;
+      disx_q   <= 1'b0;
+      e0x_q    <= 1'b0;
+      src1_q   <= '0;
+      wr1_q    <= 1'b0;
+      wr2_q    <= 1'b0;
+      dst1_q   <= '0;
+      src2_q   <= '0;
+      dst2_q   <= '0;
     end else begin
       a_q      <= a_d;
       b_q      <= b_d;
@@ -373,8 +457,6 @@ module de_pe
       lock_q   <= lock_d;
       accm_q   <= accm_d;
       act_q    <= act_d;
-      id_q     <= id_d;
-      out_q    <= out_d;
       id2_q    <= id2_d;
       xz1_q    <= xz1_d;
       act1_q   <= act1_d;
@@ -390,6 +472,16 @@ module de_pe
       accc3_q  <= accc3_d;
       pixv_q   <= pixv_d;
       pix_q    <= pix_d;
+      aez_q    <= aez_d;
+      aenz_q   <= aenz_d;
+      disx_q   <= disx_d;
+      e0x_q    <= e0x_d;
+      src1_q   <= src1_d;
+      wr1_q    <= wr1_d;
+      wr2_q    <= wr2_d;
+      dst1_q   <= dst1_d;
+      src2_q   <= src2_d;
+      dst2_q   <= dst2_d;
     end
   end
 
