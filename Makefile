@@ -15,7 +15,7 @@ PE ?= 1
 BUG ?=
 RTL_SRC := $(shell find rtl -name '*.sv' 2>/dev/null | sort)
 
-.PHONY: view gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
+.PHONY: view gen gen-check test-first-run test-quality sim sim-merge fuzz-hsr help setup demo demo-cmd anim bench-array bench-span fpga-board sim-board postsynth test test-py test-c test-rtl test-long bench bench-hsr clean waves lint fpga
 
 help:
 	@echo "make demo        the main job: teapot scene -> HSR -> yproc -> Verilated display"
@@ -45,6 +45,11 @@ help:
 	@echo "                 array (3 x 648 columns), ULX3S board bitstream (fpga/, docs/fpga.md,"
 	@echo "                 docs/board.md)"
 	@echo "make fpga-board  only the ULX3S bitstream (fpga/ulx3s)"
+	@echo "make sim-board   whole-board full-frame simulations: teapot and CAD frames and 3 animation"
+	@echo "                 frames from the SDRAM model through the TMDS encoders, bit-exact vs the"
+	@echo "                 golden model, late lines, SDRAM violations -> out/board_sim (docs/board-frames.md;"
+	@echo "                 CASES=teapot,cad,anim LOOPS=1 THREADS=1; builds the 72-chip board first:"
+	@echo "                 ~2 min, then ~1-1.5 min per case on 2 loaded cores)"
 	@echo "make postsynth   yosys netlists simulated in Icarus against the golden model"
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
 	@echo "make setup       create .venv from scripts/requirements.txt"
@@ -178,6 +183,13 @@ bench-span: $(SETUP)
 
 fpga-board: $(SETUP)
 	$(MAKE) -C fpga/ulx3s
+
+# The whole-board full-frame simulations (docs/board-frames.md): sim/board/board_sim.py.
+CASES ?= teapot,cad,anim
+LOOPS ?= 1
+sim-board: $(SETUP)
+	$(ENV) $(PY) sim/board/board_sim.py --cases $(CASES) --loops $(LOOPS) --threads $(THREADS) \
+	  --out $(OUT)/board_sim
 
 postsynth: $(SETUP)
 	$(MAKE) -C fpga postsynth

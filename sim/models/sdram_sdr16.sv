@@ -159,6 +159,7 @@ module sdram_sdr16 #(
   // State.
   logic [15:0] mem [int unsigned];      // sparse: {bank, row, col} -> word
   logic [15:0] pre [int unsigned];      // the preload image, the contents at power-on
+  bit          mem_is_pre;              // mem equals pre (no write since power-on)
   int          last_act_bank;
 
   longint    cyc;                        // index of the current edge
@@ -255,7 +256,9 @@ module sdram_sdr16 #(
   endfunction
 
   task automatic power_on();
-    mem = pre;
+    // A reset held for many clocks must not copy a large image every clock.
+    if (!mem_is_pre) mem = pre;
+    mem_is_pre = 1'b1;
     cyc = -1;
     for (int b = 0; b < NBanks; b++) begin
       active[b]  = 1'b0;
@@ -532,7 +535,10 @@ module sdram_sdr16 #(
       c = burst_col(wr_col, wr_idx, wr_len);
       old = mem.exists(key(wr_bank, wr_row, c)) ? mem[key(wr_bank, wr_row, c)] : UninitWord;
       nw  = {dqm_i[1] ? old[15:8] : dq_i[15:8], dqm_i[0] ? old[7:0] : dq_i[7:0]};
-      if (dqm_i != 2'b11) mem[key(wr_bank, wr_row, c)] = nw;
+      if (dqm_i != 2'b11) begin
+        mem[key(wr_bank, wr_row, c)] = nw;
+        mem_is_pre = 1'b0;
+      end
       // Write recovery runs from the last data-in edge, masked or not.
       t_wdata[wr_bank] = cyc;
       wr_idx = wr_idx + 1;
@@ -665,6 +671,7 @@ module sdram_sdr16 #(
     image_name = PreloadFile;
     void'($value$plusargs("sdram_image=%s", image_name));
     if (image_name != "") read_preload(image_name);
+    mem_is_pre = 1'b0;
     power_on();
     dq_o    = '0;
     dq_oe_o = 1'b0;
