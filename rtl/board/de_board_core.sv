@@ -40,7 +40,10 @@ module de_board_core #(
   parameter int unsigned TestVSync   = 2,
   parameter int unsigned TestVBp     = 2,
   parameter int unsigned SpanArray   = 0,      // 1: span-serial arrays on clk_core_i
-  parameter int unsigned SpanLatency = 300     // their Refresh -> column 0, pixel clocks
+  parameter int unsigned SpanLatency = 300,    // their Refresh -> column 0, pixel clocks
+  // Their pixel -> core FIFO, log2 slots: 2,048 slots hold the CAD scene's paced backlog
+  // (698 slots in make bench-span; 256 overflowed and lost 6 pixels a frame, docs/board-frames.md).
+  parameter int unsigned SpanFifoAw  = 11
 ) (
   input  logic            clk_i,
   input  logic            clk_core_i,
@@ -185,7 +188,8 @@ module de_board_core #(
     .TestVSync  (TestVSync),
     .TestVBp    (TestVBp),
     .SpanArray  (SpanArray),
-    .SpanLatency(SpanLatency)
+    .SpanLatency(SpanLatency),
+    .SpanFifoAw (SpanFifoAw)
   ) u_dc (
     .clk_i, .rst_i, .clk_core_i, .mode_i,
     .wr_valid_i     (wr_valid),

@@ -39,6 +39,9 @@ module display_controller #(
   parameter int unsigned TestVBp     = 2,
   parameter int unsigned SpanArray   = 0,
   parameter int unsigned SpanLatency = 300,
+  // log2 of the span array's pixel -> core FIFO (slots); 8 keeps the tested default, the
+  // board takes 11 because the CAD scene's paced backlog reaches 698 slots (docs/board-frames.md)
+  parameter int unsigned SpanFifoAw  = 8,
   // docs/array.md: a Refresh on id_i in the cycle ending with edge E puts column q on
   // pix_o right after edge E + NumChips + 2 + q, i.e. NumChips + 3 cycles later.
   localparam int unsigned ArrayLatency = SpanArray != 0 ? SpanLatency : NumChips + 3,
@@ -141,7 +144,8 @@ module display_controller #(
     de_span_video #(
       .NumCols (9 * NumChips),
       .CarryBug(CarryBug),
-      .Latency (SpanLatency)
+      .Latency (SpanLatency),
+      .FifoAw  (SpanFifoAw)
     ) u_array (
       .clk_i,
       .rst_i,

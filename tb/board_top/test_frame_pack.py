@@ -92,7 +92,7 @@ def check_plan(plan, frames, vactive, first_slot=0):
 
 
 def test_marker_is_the_isa_refresh():
-    # the packer's marker is the word the block-RAM player pads with (rtl/board/de_fs_player.sv)
+    # the packer's marker is the word the block-RAM player pads with (the retired block-RAM player; rtl/board/de_frame_fetch.sv pads the same way)
     assert binfmt.map_word(M, 0) == (isa.REFRESH, 0)
     assert M == 0x0800_0000
 
