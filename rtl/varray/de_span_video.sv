@@ -13,7 +13,8 @@
 //
 // A line must be complete in the line buffer when its read-out starts (the count of
 // completed lines crosses back in Gray code); if it is not, or a slot found the FIFO
-// full, late_o / overflow_o rise and stay up until reset: the frame is then wrong, and
+// full, late_o / overflow_o rise and stay up until reset (late_o armed once the array is
+// first idle after reset, below): the frame is then wrong, and
 // Latency or the core clock is too small for the stream. Reset: rst_i (pixel domain),
 // held for a few pixel clocks; the core side takes it through a synchroniser.
 `default_nettype none
@@ -122,15 +123,24 @@ module de_span_video
     end
   end
 
+  // Armed the first time the array is idle after reset. Its reset sweep (2 x NumCols core
+  // clocks) and the lines queued during it can outlast Latency, so a read-out before then
+  // is not a late line of the picture (it falls in the blanking after reset); counting it
+  // would leave late_o up on every board from reset on and hide a real late line.
+  logic armed_c_d, armed_c_q;
+  assign armed_c_d = armed_c_q || !cbusy;
+
   always_ff @(posedge clk_core_i) begin
     rst_c1_q <= rst_i;
     rst_c2_q <= rst_c1_q;
     if (rst_c2_q) begin
-      wline_q <= '0;
-      wgray_q <= '0;
+      wline_q   <= '0;
+      wgray_q   <= '0;
+      armed_c_q <= 1'b0;
     end else begin
-      wline_q <= wline_d;
-      wgray_q <= wline_d ^ (wline_d >> 1);
+      wline_q   <= wline_d;
+      wgray_q   <= wline_d ^ (wline_d >> 1);
+      armed_c_q <= armed_c_d;
     end
   end
 
@@ -144,6 +154,7 @@ module de_span_video
   logic [2:0]  rline_d, rline_q;
   logic [2:0]  dgray1_q, dgray2_q, done;     // completed lines, crossed from the core
   logic        late_d, late_q;
+  logic        arm1_q, arm2_q;               // armed_c_q crossed to the pixel clock (a level)
   logic [PixW-1:0] pix_q;
   logic        start;
 
@@ -168,7 +179,7 @@ module de_span_video
       rd_d   = 1'b1;
       rcol_d = '0;
       // The line must be complete (one more completed line than read out).
-      if (done == rline_q) begin
+      if (arm2_q && done == rline_q) begin
         late_d = 1'b1;
       end
     end else if (rd_q) begin
@@ -206,6 +217,8 @@ module de_span_video
       rcol_q   <= '0;
       rline_q  <= '0;
       late_q   <= 1'b0;
+      arm1_q   <= 1'b0;
+      arm2_q   <= 1'b0;
       ovf_q    <= 1'b0;
       dgray1_q <= '0;
       dgray2_q <= '0;
@@ -220,6 +233,8 @@ module de_span_video
       rcol_q   <= rcol_d;
       rline_q  <= rline_d;
       late_q   <= late_d;
+      arm1_q   <= armed_c_q;
+      arm2_q   <= arm1_q;
       ovf_q    <= ovf_d;
       dgray1_q <= wgray_q;
       dgray2_q <= dgray1_q;
@@ -233,8 +248,6 @@ module de_span_video
   assign overflow_o    = ovf_q;
 
   // The array's own busy flag is for benches; the column of a pixel is its position.
-  logic unused;
-  assign unused = cbusy;
 endmodule
 
 `default_nettype wire

@@ -605,10 +605,13 @@ int main(int argc, char** argv) {
     if (sf.ovf_at.clock >= 0)
       warnings.push_back(sf.scope + ": span array FIFO overflow (slots lost) from frame " +
                          std::to_string(sf.ovf_at.frame) + " line " + std::to_string(sf.ovf_at.line));
-    if (sf.late_at.clock >= 0 && first_live >= 0 && sf.late_at.frame >= first_live)
-      warnings.push_back(sf.scope + ": span array late line in frame " +
-                         std::to_string(sf.late_at.frame) + " line " +
-                         std::to_string(sf.late_at.line));
+    // A late flag is an error wherever it rises: since de_span_video arms its check only
+    // when the array's reset sweep is done, nothing may raise it, not even after reset.
+    if (sf.late_at.clock >= 0)
+      errors.push_back(sf.scope + ": span array late line at pixel clock " +
+                       std::to_string(sf.late_at.clock) + ", frame " +
+                       std::to_string(sf.late_at.frame) + " line " +
+                       std::to_string(sf.late_at.line));
   }
   if (drop_total) errors.push_back(std::to_string(drop_total) + " dropped word(s)");
   if (sd_err) errors.push_back(std::to_string(sd_err) + " SDRAM timing violation(s)");
