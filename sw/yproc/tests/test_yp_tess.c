@@ -11,12 +11,7 @@
 #include <string.h>
 #include "t.h"
 #include "yp_internal.h"
-
-static void wfile(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    if (f) { fputs(text, f); fclose(f); }
-}
+#include "yp_fixture.h"
 
 typedef struct ta { yp_anim *an; hsr_scene *sc; yp_shader *sh; hsr_ctx *h; yp_frame *fr; yp_options o; int W, H; } ta;
 
@@ -83,21 +78,7 @@ static int equals_full(ta *t, const yp_options *o)
  * after the grid has gone every line is back at full quality. */
 static void test_lod_fit_no_late_line_from_frame_0_and_quality_back(void)
 {
-    char obj[65536];
-    int k = 0, nv = 0;
-    for (int gy = 0; gy < 6; gy++)
-        for (int gx = 0; gx < 14; gx++) {
-            double x0 = -1.9 + gx * 0.27, y0 = -0.9 + gy * 0.3, x1 = x0 + 0.2, y1 = y0 + 0.22;
-            k += snprintf(obj + k, sizeof obj - (size_t)k, "v %g %g 0.3\nv %g %g 0.35\nv %g %g 0.3\nv %g %g 0.25\nf %d %d %d %d\n",
-                          x0, y0, x1, y0, x1, y1, x0, y1, nv + 1, nv + 2, nv + 3, nv + 4);
-            nv += 4;
-        }
-    wfile("build/tf_grid.obj", obj);
-    wfile("build/tf_plate.obj", "v -2.4 -1.8 0\nv 2.4 -1.8 0\nv 2.4 1.8 0\nv -2.4 1.8 0\nf 1 2 3 4\n");
-    wfile("build/tf_grid.scene", "screen 96 48\ncamera eye 0 0 5 at 0 0 0 up 0 1 0 fov 40\nlight 0.3 0.4 1 0.6\nambient 0.2\n"
-          "background 0.1 0.1 0.1\nmaterial plate 0.5 0.5 0.5\nmaterial tile 0.7 0.4 0.2 specular 0.15 20\n"
-          "obj tf_plate.obj material plate\nobj tf_grid.obj material tile\n");
-    wfile("build/tf_grid.anim", "scene tf_grid.scene\nframes 24\nmove 1 5 0 0 from 6 to 9\n");
+    ypt_grid_anim("tf", 24);
     ta t;
     CHECK(ta_open(&t, "build/tf_grid.anim"));
     if (!t.fr) { ta_close(&t); return; }
@@ -153,9 +134,9 @@ static const char *make_sheet(void)
             int a = j * 41 + i + 1, b = a + 1, c = a + 41, d = c + 1;
             k += snprintf(obj + k, sizeof obj - (size_t)k, "f %d %d %d\nf %d %d %d\n", a, b, d, a, d, c);
         }
-    wfile("build/ts_sheet.obj", obj);
-    wfile("build/ts_plate.obj", "v -2.4 -1.8 0\nv 2.4 -1.8 0\nv 2.4 1.8 0\nv -2.4 1.8 0\nf 1 2 3 4\n");
-    wfile("build/ts.scene", "screen 128 96\ncamera eye 0 0 5 at 0 0 0 up 0 1 0 fov 50\nlight 0.3 0.4 1 0.6\nambient 0.2\n"
+    ypt_write_file("build/ts_sheet.obj", obj);
+    ypt_write_file("build/ts_plate.obj", "v -2.4 -1.8 0\nv 2.4 -1.8 0\nv 2.4 1.8 0\nv -2.4 1.8 0\nf 1 2 3 4\n");
+    ypt_write_file("build/ts.scene", "screen 128 96\ncamera eye 0 0 5 at 0 0 0 up 0 1 0 fov 50\nlight 0.3 0.4 1 0.6\nambient 0.2\n"
           "background 0.1 0.1 0.1\nmaterial plate 0.5 0.5 0.5\nmaterial sheet 0.7 0.4 0.2 specular 0.15 20\n"
           "obj ts_plate.obj material plate\nobj ts_sheet.obj material sheet\n");
     return "build/ts.scene";
@@ -164,7 +145,7 @@ static const char *make_sheet(void)
 static void test_tessellation_versions_cluster_and_switch_incrementally(void)
 {
     make_sheet();
-    wfile("build/ts.anim", "scene ts.scene\nframes 4\ntessellation 1 0.25 3\nmove 1 0.3 0 0 from 1 to 3\n");
+    ypt_write_file("build/ts.anim", "scene ts.scene\nframes 4\ntessellation 1 0.25 3\nmove 1 0.3 0 0 from 1 to 3\n");
     ta t;
     CHECK(ta_open(&t, "build/ts.anim"));
     if (!t.fr) { ta_close(&t); return; }
@@ -204,9 +185,9 @@ static void test_tessellation_versions_cluster_and_switch_incrementally(void)
     CHECK(slots[1] < slots[0] && slots[2] < slots[1]);
     char err[256] = "";
     yp_anim *bad = NULL;
-    wfile("build/ts_bad.anim", "scene ts.scene\ntessellation 7 0.25\n");
+    ypt_write_file("build/ts_bad.anim", "scene ts.scene\ntessellation 7 0.25\n");
     CHECK(yp_anim_load("build/ts_bad.anim", &bad, err, sizeof err) == HSR_EPARSE && strstr(err, "ts_bad.anim:2:"));
-    wfile("build/ts_bad.anim", "scene ts.scene\ntessellation 1 0.25 9\n");
+    ypt_write_file("build/ts_bad.anim", "scene ts.scene\ntessellation 1 0.25 9\n");
     CHECK(yp_anim_load("build/ts_bad.anim", &bad, err, sizeof err) == HSR_EPARSE && strstr(err, "VERSIONS"));
     ta_close(&t);
 }
@@ -218,7 +199,7 @@ static void test_tessellation_versions_cluster_and_switch_incrementally(void)
 static void test_tessellation_loop_coarser_when_overloaded_finer_when_load_falls(void)
 {
     make_sheet();
-    wfile("build/ts_loop.anim", "scene ts.scene\nframes 24\ntessellation 1 0.25 3\nmove 1 3.6 0 0 from 4 to 8\n");
+    ypt_write_file("build/ts_loop.anim", "scene ts.scene\nframes 24\ntessellation 1 0.25 3\nmove 1 3.6 0 0 from 4 to 8\n");
     ta t;
     CHECK(ta_open(&t, "build/ts_loop.anim"));
     if (!t.fr) { ta_close(&t); return; }

@@ -9,12 +9,7 @@
 #include <string.h>
 #include "t.h"
 #include "yp_internal.h"
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    if (f) { fputs(text, f); fclose(f); }
-}
+#include "yp_fixture.h"
 
 /* a 48x36 textured quad seen square-on, one point light */
 #define PATTERN_SCENE "screen 48 36\ncamera eye 0 0 5 at 0 0 0 up 0 1 0 fov 40\nlight 0 0 1 0.5\nambient 0.1\n" \
@@ -24,9 +19,9 @@ static void write_file(const char *path, const char *text)
 
 static void make_pattern_files(void)
 {
-    write_file("build/t_quad.obj", "v -2.1 -1.55 0\nv 2.1 -1.55 0\nv 2.1 1.55 0\nv -2.1 1.55 0\nf 1 2 3 4\n");
-    write_file("build/t_tex.scene", PATTERN_SCENE);
-    write_file("build/t_tex.anim", PATTERN_ANIM);
+    ypt_write_file("build/t_quad.obj", "v -2.1 -1.55 0\nv 2.1 -1.55 0\nv 2.1 1.55 0\nv -2.1 1.55 0\nf 1 2 3 4\n");
+    ypt_write_file("build/t_tex.scene", PATTERN_SCENE);
+    ypt_write_file("build/t_tex.anim", PATTERN_ANIM);
 }
 
 /* an animation at frame 0: scene, Phong shader (without the .anim's point lights and
@@ -137,7 +132,7 @@ static void test_point_light_brightest_under_it_and_follows_it(void)
 static void test_wander_moves_continuously_towards_random_points_in_its_box(void)
 {
     make_pattern_files();
-    write_file("build/t_w.anim", "scene t_tex.scene\nframes 40\npointlight 0 0.4 0.3 0.9\n"
+    ypt_write_file("build/t_w.anim", "scene t_tex.scene\nframes 40\npointlight 0 0.4 0.3 0.9\n"
                "wander 0 99 5 -1.8 -1.3 0.5 1.8 1.3 1.2 from 0 to 39\n");
     tanim ta;
     if (!tanim_open(&ta, "build/t_w.anim", 1)) return;
@@ -172,10 +167,10 @@ static void test_wander_moves_continuously_towards_random_points_in_its_box(void
     tanim_close(&ta);
     an = NULL;
     /* errors name the file and line */
-    write_file("build/t_w2.anim", "scene t_tex.scene\nframes 4\nwander 0 1 2 0 0 0 1 1 1 from 0 to 3\n");
+    ypt_write_file("build/t_w2.anim", "scene t_tex.scene\nframes 4\nwander 0 1 2 0 0 0 1 1 1 from 0 to 3\n");
     CHECK(yp_anim_load("build/t_w2.anim", &an, err, sizeof err) == HSR_EPARSE);
     CHECK(strstr(err, "t_w2.anim:3:") && strstr(err, "not a point light"));
-    write_file("build/t_w3.anim", "scene t_tex.scene\n\ntexture nosuch 0.3 0.4 1 1 1 7\n");
+    ypt_write_file("build/t_w3.anim", "scene t_tex.scene\n\ntexture nosuch 0.3 0.4 1 1 1 7\n");
     CHECK(yp_anim_load("build/t_w3.anim", &an, err, sizeof err) == HSR_EPARSE);
     CHECK(strstr(err, "t_w3.anim:3:") && strstr(err, "unknown material"));
 }
@@ -294,7 +289,7 @@ static void test_textured_anim_changes_only_the_light_terms(void)
 static void test_coherent_scan_keeps_what_still_fits(void)
 {
     make_pattern_files();
-    write_file("build/t_slow.anim", "scene t_tex.scene\nframes 10\ntexture pattern 0.3 0.4 1 0.8 0.55 7 8\n"
+    ypt_write_file("build/t_slow.anim", "scene t_tex.scene\nframes 10\ntexture pattern 0.3 0.4 1 0.8 0.55 7 8\n"
                "pointlight 0 0.4 0.3 0.9 falloff 2.5\nwander 0 2718 400 -1.8 -1.3 0.5 1.8 1.3 1.2 from 0 to 9\n");
     long ch_coh, tot_coh, ch_plain, tot_plain;
     double w_coh, w_plain;
@@ -359,21 +354,7 @@ static void test_lod_update_lowers_late_lines_and_raises_when_load_falls(void)
  * grid has left, the levels climb back to full quality. */
 static void test_lod_loop_removes_overflow_and_restores_quality(void)
 {
-    char obj[65536];
-    int k = 0, nv = 0;
-    for (int gy = 0; gy < 6; gy++)
-        for (int gx = 0; gx < 14; gx++) {
-            double x0 = -1.9 + gx * 0.27, y0 = -0.9 + gy * 0.3, x1 = x0 + 0.2, y1 = y0 + 0.22;
-            k += snprintf(obj + k, sizeof obj - (size_t)k, "v %g %g 0.3\nv %g %g 0.35\nv %g %g 0.3\nv %g %g 0.25\nf %d %d %d %d\n",
-                          x0, y0, x1, y0, x1, y1, x0, y1, nv + 1, nv + 2, nv + 3, nv + 4);
-            nv += 4;
-        }
-    write_file("build/t_grid.obj", obj);
-    write_file("build/t_plate.obj", "v -2.4 -1.8 0\nv 2.4 -1.8 0\nv 2.4 1.8 0\nv -2.4 1.8 0\nf 1 2 3 4\n");
-    write_file("build/t_grid.scene", "screen 96 48\ncamera eye 0 0 5 at 0 0 0 up 0 1 0 fov 40\nlight 0.3 0.4 1 0.6\nambient 0.2\n"
-               "background 0.1 0.1 0.1\nmaterial plate 0.5 0.5 0.5\nmaterial tile 0.7 0.4 0.2 specular 0.15 20\n"
-               "obj t_plate.obj material plate\nobj t_grid.obj material tile\n");
-    write_file("build/t_grid.anim", "scene t_grid.scene\nframes 14\nmove 1 5 0 0 from 6 to 9\n");
+    ypt_grid_anim("t", 14);
     tanim t;
     if (!tanim_open(&t, "build/t_grid.anim", 1)) return;
     yp_shader *sh = t.sh;
