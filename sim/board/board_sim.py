@@ -118,24 +118,10 @@ def golden(fr) -> np.ndarray:
     return out8(img)
 
 
-# The loader's version-2 packets (docs/sdram-frames-spec.md §3): the host tool's encoders
-# (de32_load.cmd_f / cmd_q, branch sdram-rtl); these stand in only while it lacks them.
-def _cmd_f(ch: int, slot: int, table: int, window: int, comp: bool) -> bytes:
-    return de32_load.with_chk(b"F" + bytes([ch, slot]) + table.to_bytes(3, "big")
-                              + bytes([window, int(comp)]))
-
-
-def _cmd_q(first: int, count: int, hold: int, loop: int) -> bytes:
-    return de32_load.with_chk(b"Q" + bytes([first, count, hold, int(loop)]))
-
-
-cmd_f = getattr(de32_load, "cmd_f", _cmd_f)
-cmd_q = getattr(de32_load, "cmd_q", _cmd_q)
-
-
 def host_packets(plan: frame_pack.Plan) -> list[bytes]:
-    return ([de32_load.cmd_o(SHIFT, SAT)] + [cmd_f(*s) for s in plan.slots]
-            + [cmd_q(*plan.sequence)])
+    # The loader's version-2 packets (docs/sdram-frames-spec.md §3), from the host tool.
+    return ([de32_load.cmd_o(SHIFT, SAT)] + [de32_load.cmd_f(*s) for s in plan.slots]
+            + [de32_load.cmd_q(*plan.sequence)])
 
 
 # ---------------------------------------------------------------------------- one case
