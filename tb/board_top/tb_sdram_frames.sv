@@ -1,0 +1,70 @@
+// Test top for tb/board_top/test_sdram_frames.py: the SDRAM frame store
+// rtl/board/de_sdram_frames.sv alone on the timing-checking SDRAM model
+// sim/models/sdram_sdr16.sv (DQ joined at the pins as in tb_board_sdram.sv), with the
+// words each player takes from its prefetch FIFO brought out for the checker.
+`default_nettype none
+
+module tb_sdram_frames #(
+  parameter int unsigned PfDepth   = 16,
+  parameter int unsigned SdTinitNs = 2000
+) (
+  input  wire logic             clk_i,
+  input  wire logic             clk_sdram_i,
+  input  wire logic             rst_i,
+  input  wire logic [11:0]      vactive_i,
+  input  wire logic             cmd_valid_i,
+  output      logic             cmd_ready_o,
+  input  wire logic [56:0]      cmd_i,
+  input  wire logic [2:0]       wr_ready_i,
+  output      logic [2:0]       wr_valid_o,
+  // The players' takes (pixel clock): {comp, window, word} per colour.
+  output      logic [2:0]       take_o,
+  output      logic [2:0][35:0] take_data_o,
+  output      logic [7:0]       malformed_o,
+  output      logic [7:0]       late_o,
+  output      logic             q_pending_o,
+  output      logic             sd_init_done_o,
+  output      logic [31:0]      err_count_o,
+  output      logic [31:0]      ref_count_o
+);
+  logic        cke, cs_n, ras_n, cas_n, we_n, c_oe, m_oe;
+  logic [1:0]  ba, dqm;
+  logic [12:0] a;
+  logic [15:0] c_dq, m_dq, bus;
+  logic [2:0][47:0] wr_data;
+  logic        frame;
+
+  de_sdram_frames #(.PfDepth(PfDepth), .SdTckPs(8000), .SdTinitNs(SdTinitNs)) u_fr (
+    .clk_i, .rst_i, .clk_sdram_i, .vactive_i, .cmd_valid_i, .cmd_ready_o, .cmd_i,
+    .wr_valid_o, .wr_ready_i, .wr_data_o(wr_data), .dc_late_i(3'b000),
+    .frame_o(frame), .q_pending_o, .malformed_o, .late_o, .sd_init_done_o,
+    .sd_cke_o(cke), .sd_cs_n_o(cs_n), .sd_ras_n_o(ras_n), .sd_cas_n_o(cas_n),
+    .sd_we_n_o(we_n), .sd_ba_o(ba), .sd_a_o(a), .sd_dqm_o(dqm),
+    .sd_dq_o(c_dq), .sd_dq_oe_o(c_oe), .sd_dq_i(bus)
+  );
+
+  assign take_o      = u_fr.pf_take & u_fr.pf_rvalid;
+  assign take_data_o = u_fr.pf_rdata;
+
+  assign bus = c_oe ? c_dq : (m_oe ? m_dq : 16'hzzzz);
+
+  logic [15:0] err_seen;
+  logic [3:0]  err_code;
+  logic [31:0] cycle;
+  logic        init_done_m;
+  logic [2:0]  cl_m;
+  logic [9:0]  bl_m;
+
+  sdram_sdr16 #(.TckPs(8000), .TinitNs(SdTinitNs)) u_sdram (
+    .clk_i(clk_sdram_i), .rst_i,
+    .cke_i(cke), .cs_n_i(cs_n), .ras_n_i(ras_n), .cas_n_i(cas_n), .we_n_i(we_n),
+    .ba_i(ba), .a_i(a), .dqm_i(dqm), .dq_i(c_dq), .dq_o(m_dq), .dq_oe_o(m_oe),
+    .err_count_o, .err_seen_o(err_seen), .err_code_o(err_code), .cycle_o(cycle),
+    .init_done_o(init_done_m), .ref_count_o, .cl_o(cl_m), .bl_o(bl_m)
+  );
+
+  logic unused;
+  assign unused = ^{err_seen, err_code, cycle, init_done_m, cl_m, bl_m, wr_data, frame};
+endmodule
+
+`default_nettype wire
