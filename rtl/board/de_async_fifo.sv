@@ -10,8 +10,8 @@
 // Write side: wready_o = not full; wfree_o = free entries, registered and conservative:
 // it counts every push up to this clock as if one more came in this clock, and pops only
 // once they have crossed (it does not wait for this clock's push, so the push decision
-// and the pointer arithmetic are in different clocks). For a writer that reserves room
-// ahead (credit: the SDRAM read bursts of de_frame_fetch).
+// and the pointer arithmetic are in different clocks); de_sdram_frames uses it to see
+// its X FIFO drained (its prefetch FIFOs' credit is kept on the read side's clock).
 // Read side: show-ahead (rvalid_o / rdata_o / rready_o). The memory is read only when
 // the synchronised write pointer says the entry is written, at least one read clock after
 // the synchroniser saw it, into the output register, so the two ports never touch the
@@ -45,24 +45,16 @@ module de_async_fifo #(
   end
 
   typedef logic [AW:0] ptr_t;
+  localparam int unsigned HB = (AW + 1) / 2;   // the pointer's bottom half (Gray decode)
 
   function automatic ptr_t bin2gray(ptr_t b);
     return b ^ (b >> 1);
   endfunction
 
-  // Each bit its own XOR reduction (not b[i] = b[i+1] ^ g[i]): synthesis keeps the
-  // chain form as a chain, 11 LUTs deep at Depth 2048, the worst path of the 125 MHz
-  // write side; as reductions it maps to trees of 2-3 LUTs.
-  function automatic ptr_t gray2bin(ptr_t g);
-    ptr_t b;
-    for (int i = 0; i <= int'(AW); i++) b[i] = ^(g >> i);
-    return b;
-  endfunction
-
   logic [Width-1:0] mem_q [Depth];
 
   // Write side.
-  ptr_t wbin_d, wbin_q, wgray_q, rbin_w_q, wfree_d, wfree_q, used;
+  ptr_t wbin_d, wbin_q, wgray_q, rdec_q, rbin_w_q, wfree_d, wfree_q, used;
   (* ASYNC_REG = "TRUE" *) ptr_t rgray_w1_q, rgray_w2_q;
   logic push;
   // Read side.
@@ -73,8 +65,12 @@ module de_async_fifo #(
 
   // ---------------------------------------------------------------- write side
 
-  // The read pointer in binary is registered too (one more clock of conservatism): the
-  // Gray decode is off the 125 MHz write side's paths.
+  // The read pointer in binary is registered too, its Gray decode in two registered
+  // steps (one more clock of conservatism): the top half first (rdec_q: top half binary,
+  // bottom half still Gray), then the bottom half from the top's lowest bit. Each bit is
+  // an XOR of at most half the pointer plus one, two LUT levels; decoded in one step, the
+  // bits share a chain (b[i] = b[i+1] ^ g[i]) that synthesis keeps 9-11 LUTs deep at
+  // Depth 2048, the worst path of the 125 MHz write side.
   assign used     = wbin_q - rbin_w_q;                 // 0 .. Depth
   assign wready_o = !used[AW];
   assign push     = wvalid_i && wready_o;
@@ -92,6 +88,7 @@ module de_async_fifo #(
       wgray_q    <= '0;
       rgray_w1_q <= '0;
       rgray_w2_q <= '0;
+      rdec_q     <= '0;
       rbin_w_q   <= '0;
       wfree_q    <= ptr_t'(Depth);
     end else begin
@@ -99,7 +96,10 @@ module de_async_fifo #(
       wgray_q    <= bin2gray(wbin_d);
       rgray_w1_q <= rgray_q;
       rgray_w2_q <= rgray_w1_q;
-      rbin_w_q   <= gray2bin(rgray_w2_q);
+      for (int i = 0; i <= int'(AW); i++) begin
+        rdec_q[i]   <= (i >= int'(HB)) ? ^(rgray_w2_q >> i) : rgray_w2_q[i];
+        rbin_w_q[i] <= (i >= int'(HB)) ? rdec_q[i] : rdec_q[HB] ^ (^(rdec_q[HB-1:0] >> i));
+      end
       wfree_q    <= wfree_d;
     end
   end

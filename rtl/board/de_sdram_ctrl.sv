@@ -239,6 +239,10 @@ module de_sdram_ctrl #(
   // Each command of the request is one AND of its step and its registered gap flags, so
   // the five are exclusive and no priority chain sits in front of the pins.
   logic do_pre, do_act, do_rd, do_wr, do_wr2, all_pre_ok, all_closed_ok;
+  // The refresh's PRECHARGE ALL waits for all_pre_ok a clock old: it is computed only
+  // in clocks that issue no command (SRun without a request, SRefPre), so it still holds
+  // a clock later, and the 4-bank AND is not in front of the pins.
+  logic all_pre_ok_q;
 
   always_comb begin
     e_ras  = f_ras_q & ~r_act_q;
@@ -409,7 +413,7 @@ module de_sdram_ctrl #(
       SRefPre: begin
         if (open_q == '0) begin
           state_d = SRef;
-        end else if (all_pre_ok) begin
+        end else if (all_pre_ok_q) begin
           cmd_d   = CmdPre;
           a_d     = '0;
           a_d[10] = 1'b1;
@@ -499,6 +503,12 @@ module de_sdram_ctrl #(
   end
 
   // ---------------------------------------------------------------- registers
+  always_ff @(posedge clk_i) begin
+    if (rst_i) all_pre_ok_q <= 1'b0;
+    else       all_pre_ok_q <= all_pre_ok &&
+                               ((state_q == SRun && !cur_valid_q) || state_q == SRefPre);
+  end
+
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
       state_q     <= SInitWait;

@@ -408,7 +408,7 @@ module de_sdram_frames #(
   // Each FIFO's head is taken into a hold register when that is empty, so the FIFO's
   // read side depends on one flip-flop only, not on the arbiter.
   req_t [NumCh-1:0] h_q;
-  logic [NumCh-1:0] hv_q, hv_d, pad_go, want, grant;
+  logic [NumCh-1:0] hv_q, hv_d, pad_go, want_d, want_q, grant;
   logic [NumCh-1:0][2:0] outst_q, outst_d;  // granted reads whose last word is not back
 
   for (genvar c = 0; c < NumCh; c++) begin : g_hold
@@ -424,55 +424,58 @@ module de_sdram_frames #(
   // writes before its Q), then the colours round robin; the winner goes into one output
   // register, which the controller accepts (its ready depends on its own state only).
   // The register is loaded only when it is empty, so the choice depends on flip-flops
-  // only; that costs no bandwidth: the controller takes its next request at the
-  // soonest two clocks after the last one (the clock after it issued that one's READ).
+  // only (want_q: a read waits in the hold and the info FIFO has room, registered);
+  // that costs no bandwidth: the controller takes its next request at the soonest two
+  // clocks after the last one (the clock after it issued that one's READ).
   logic        out_v_d, out_v_q, out_wr_d, out_wr_q, load, accepted, win_x;
   logic [22:0] out_addr_d, out_addr_q;
   logic [1:0]  out_tag_d, out_tag_q;
   logic [31:0] out_data_d, out_data_q;
   logic [1:0]  rr_d, rr_q;              // the colour granted last
   logic        ctl_wr_ready, ctl_rd_ready;
-  logic        info_room_q;
+  logic        info_room_d;
 
   assign accepted = out_v_q && (out_wr_q ? ctl_wr_ready : ctl_rd_ready);
   assign load     = !out_v_q;
-  for (genvar c = 0; c < NumCh; c++) begin : g_want
-    assign want[c] = hv_q[c] && !h_q[c].pad && info_room_q;
-  end
   assign win_x = load && xv_q;
 
   always_comb begin
     grant = '0;
     if (load && !xv_q) begin
       unique case (rr_q)
-        2'd0:    grant = want[1] ? 3'b010 : want[2] ? 3'b100 : want[0] ? 3'b001 : 3'b000;
-        2'd1:    grant = want[2] ? 3'b100 : want[0] ? 3'b001 : want[1] ? 3'b010 : 3'b000;
-        default: grant = want[0] ? 3'b001 : want[1] ? 3'b010 : want[2] ? 3'b100 : 3'b000;
+        2'd0:    grant = want_q[1] ? 3'b010 : want_q[2] ? 3'b100 : want_q[0] ? 3'b001 : 3'b000;
+        2'd1:    grant = want_q[2] ? 3'b100 : want_q[0] ? 3'b001 : want_q[1] ? 3'b010 : 3'b000;
+        default: grant = want_q[0] ? 3'b001 : want_q[1] ? 3'b010 : want_q[2] ? 3'b100 : 3'b000;
       endcase
     end
   end
 
+  // Loaded whenever empty (the enable is out_v_q alone); the read's fields as an AND-OR
+  // of the one-hot grant.
+  logic [22:0] sel_addr;
+  logic [1:0]  sel_tag;
   always_comb begin
-    rr_d       = rr_q;
-    out_v_d    = out_v_q && !accepted;
+    sel_addr = '0;
+    sel_tag  = '0;
+    for (int c = 0; c < int'(NumCh); c++) begin
+      sel_addr |= {23{grant[c]}} & {2'(c), h_q[c].off};
+      sel_tag  |= {2{grant[c]}} & 2'(c);
+    end
+  end
+
+  always_comb begin
+    rr_d       = (|grant) ? sel_tag : rr_q;
+    // Full: until accepted; empty: loaded if anything wants it (not through grant).
+    out_v_d    = out_v_q ? !accepted : (xv_q || |want_q);
     out_wr_d   = out_wr_q;
     out_addr_d = out_addr_q;
     out_tag_d  = out_tag_q;
     out_data_d = out_data_q;
-    if (win_x) begin
-      out_v_d    = 1'b1;
-      out_wr_d   = 1'b1;
-      out_addr_d = {x_q[54:53], x_q[52:32]};
+    if (!out_v_q) begin
+      out_wr_d   = xv_q;
+      out_addr_d = xv_q ? {x_q[54:53], x_q[52:32]} : sel_addr;
+      out_tag_d  = sel_tag;
       out_data_d = x_q[31:0];
-    end
-    for (int c = 0; c < int'(NumCh); c++) begin
-      if (grant[c]) begin
-        rr_d       = 2'(c);
-        out_v_d    = 1'b1;
-        out_wr_d   = 1'b0;
-        out_tag_d  = 2'(c);
-        out_addr_d = {2'(c), h_q[c].off};
-      end
     end
   end
 
@@ -530,8 +533,10 @@ module de_sdram_frames #(
 
   // ---------------------------------------------------------------- info FIFO
   // What each granted read is, in grant order (the controller answers in order): a ring
-  // written at the grant and a head register, reloaded in the clock after a burst's
-  // last word (the next burst's first word comes 2 clocks after it at the soonest).
+  // written a clock after the grant (from registers: the grant's multiplexer is not in
+  // front of the RAM's write port) and a head register, reloaded in the clock after a
+  // burst's last word (the next burst's first word comes 2 clocks after it at the
+  // soonest; a burst's first word comes 8 clocks after its grant at the soonest).
   localparam int unsigned InfoDepth = 8;
   typedef struct packed {
     logic       tbl;
@@ -544,41 +549,43 @@ module de_sdram_frames #(
   info_t       info_mem_q [InfoDepth];
   logic [2:0]  info_wp_q, info_rp_q;
   logic [3:0]  info_cnt_q, info_cnt_d;
-  info_t       head_q, info_new;
-  logic        head_v_q, info_push, head_load;
+  info_t       head_q, info_new, info_new_q;
+  logic        head_v_q, info_push, info_push_q, head_load;
   logic [1:0]  widx_q;
 
   always_comb begin
     info_new = '0;
-    for (int c = 0; c < int'(NumCh); c++) begin
-      if (grant[c]) info_new = '{tbl: h_q[c].tbl, vmask: h_q[c].vmask, lmask: h_q[c].lmask,
-                                 win: h_q[c].win, comp: h_q[c].comp};
+    for (int c = 0; c < int'(NumCh); c++) begin   // one-hot grant: an AND-OR
+      info_new |= {$bits(info_t){grant[c]}} &
+                  {h_q[c].tbl, h_q[c].vmask, h_q[c].lmask, h_q[c].win, h_q[c].comp};
     end
   end
   assign info_push  = |grant;
   assign head_load  = !head_v_q && info_cnt_q != 4'd0;
-  assign info_cnt_d = info_cnt_q + 4'(info_push) - 4'(head_load);
+  assign info_cnt_d = info_cnt_q + 4'(info_push_q) - 4'(head_load);
+  // From the registered count only (not this clock's grant): with at most one grant per
+  // clock (written a clock later) the ring then holds at most InfoDepth - 1 (in flight
+  // are the output register, the controller's request and the bursts coming back).
+  assign info_room_d = info_cnt_q <= 4'(InfoDepth - 5);
 
   always_ff @(posedge clk_sdram_i) begin
-    if (info_push) info_mem_q[info_wp_q] <= info_new;
-    if (head_load) head_q <= info_mem_q[info_rp_q];
+    info_new_q <= info_new;
+    if (info_push_q) info_mem_q[info_wp_q] <= info_new_q;
+    if (head_load)   head_q <= info_mem_q[info_rp_q];
   end
   always_ff @(posedge clk_sdram_i) begin
     if (rst_sd) begin
+      info_push_q <= 1'b0;
       info_wp_q   <= '0;
       info_rp_q   <= '0;
       info_cnt_q  <= '0;
-      info_room_q <= 1'b1;
       head_v_q    <= 1'b0;
       widx_q      <= 2'd0;
     end else begin
-      if (info_push) info_wp_q <= info_wp_q + 3'd1;
+      info_push_q <= info_push;
+      if (info_push_q) info_wp_q <= info_wp_q + 3'd1;
       if (head_load) info_rp_q <= info_rp_q + 3'd1;
       info_cnt_q  <= info_cnt_d;
-      // From the registered count only (not this clock's grant): with at most one grant
-      // per clock the ring then holds at most InfoDepth - 2 (in flight are the output
-      // register, the controller's request and the bursts coming back).
-      info_room_q <= info_cnt_q <= 4'(InfoDepth - 4);
       if (head_load)                        head_v_q <= 1'b1;
       else if (ctl_rd_valid && ctl_rd_last) head_v_q <= 1'b0;
       if (ctl_rd_valid) widx_q <= widx_q + 2'd1;
@@ -587,20 +594,26 @@ module de_sdram_frames #(
 
   // ---------------------------------------------------------------- outstanding reads
   for (genvar c = 0; c < NumCh; c++) begin : g_outst
+    req_t rq_head;
+    assign rq_head = req_t'(rq_data[c]);
     always_comb begin
       outst_d[c] = outst_q[c] + 3'(grant[c])
                    - 3'(ctl_rd_valid && ctl_rd_last && ctl_rd_tag == 2'(c));
       hv_d[c]    = (hv_q[c] && !grant[c] && !pad_go[c]) || (rq_valid[c] && !hv_q[c]);
+      // Next clock's "a read waits in the hold" (the hold's next request, or the kept one).
+      want_d[c]  = hv_d[c] && info_room_d && !(hv_q[c] ? h_q[c].pad : rq_head.pad);
     end
     always_ff @(posedge clk_sdram_i) begin
       if (rst_sd) begin
         outst_q[c] <= '0;
         hv_q[c]    <= 1'b0;
+        want_q[c]  <= 1'b0;
       end else begin
         outst_q[c] <= outst_d[c];
+        want_q[c]  <= want_d[c];
         hv_q[c]    <= hv_d[c];
       end
-      if (rq_valid[c] && !hv_q[c]) h_q[c] <= req_t'(rq_data[c]);
+      if (rq_valid[c] && !hv_q[c]) h_q[c] <= rq_head;
     end
   end
 
