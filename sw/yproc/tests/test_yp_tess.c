@@ -123,12 +123,21 @@ static const char *make_sheet(void)
     return "build/ts.scene";
 }
 
+/* the sheet scene and an animation of it (path, the lines after its scene line), opened at
+ * frame 0 (ypt_anim_start) */
+static int sheet_start(ypt_anim *t, const char *path, const char *anim)
+{
+    char text[512];
+    make_sheet();
+    snprintf(text, sizeof text, "scene ts.scene\n%s", anim);
+    ypt_write_file(path, text);
+    return ypt_anim_start(t, path, 1);
+}
+
 static void test_tessellation_versions_cluster_and_switch_incrementally(void)
 {
-    make_sheet();
-    ypt_write_file("build/ts.anim", "scene ts.scene\nframes 4\ntessellation 1 0.25 3\nmove 1 0.3 0 0 from 1 to 3\n");
     ypt_anim t;
-    if (!ypt_anim_start(&t, "build/ts.anim", 1)) return;
+    if (!sheet_start(&t, "build/ts.anim", "frames 4\ntessellation 1 0.25 3\nmove 1 0.3 0 0 from 1 to 3\n")) return;
     yp_tess *ts = yp_anim_tess(t.an);
     CHECK(yp_tess_count(ts) == 1 && yp_tess_versions(ts, 0) == 3 && yp_tess_get(ts, 0) == 0);
     CHECK(yp_tess_obj(ts, 0, 0) == 1 && yp_tess_obj(ts, 0, 1) == 2 && yp_tess_obj(ts, 0, 2) == 3);
@@ -178,10 +187,8 @@ static void test_tessellation_versions_cluster_and_switch_incrementally(void)
  * back to the finer mesh without a late line; every frame equals its full rebuild. */
 static void test_tessellation_loop_coarser_when_overloaded_finer_when_load_falls(void)
 {
-    make_sheet();
-    ypt_write_file("build/ts_loop.anim", "scene ts.scene\nframes 24\ntessellation 1 0.25 3\nmove 1 3.6 0 0 from 4 to 8\n");
     ypt_anim t;
-    if (!ypt_anim_start(&t, "build/ts_loop.anim", 1)) return;
+    if (!sheet_start(&t, "build/ts_loop.anim", "frames 24\ntessellation 1 0.25 3\nmove 1 3.6 0 0 from 4 to 8\n")) return;
     yp_tess *ts = yp_anim_tess(t.an);
     int H = t.H, iss[128], late[128];
     yp_options o = t.o;
