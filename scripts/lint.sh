@@ -31,14 +31,16 @@ for f in rtl/board/*.sv; do
     */de_board_core.sv) ;;
     */de_frame_player.sv) lint_top de_frame_player $(files input) "$f" ;;
     */de_sdram_frames.sv) lint_top de_sdram_frames $(files sdram_ctrl) \
-        rtl/board/de_async_fifo.sv rtl/board/de_frame_fetch.sv $(files input) \
+        $(files prim) rtl/board/de_frame_fetch.sv $(files input) \
         rtl/board/de_frame_player.sv "$f" ;;
-    */de_uart_pkg.sv) ;;   # linted with its users below
+    */de_uart_pkg.sv|*/de_sdram_pkg.sv) ;;   # linted with their users
+    */de_sdram_ctrl.sv) lint_top de_sdram_ctrl $(files sdram_ctrl) ;;
     */de_uart_rx.sv|*/de_uart_tx.sv) lint_top "$(basename "$f" .sv)" rtl/board/de_uart_pkg.sv "$f" ;;
     */de_uart_link.sv) lint_top de_uart_link rtl/board/de_uart_{pkg,rx,tx}.sv "$f" ;;
     *) lint_top "$(basename "$f" .sv)" "$f" ;;
   esac
 done
+lint_top de_async_fifo $(files prim lint)
 lint_top de_span_array $(files span_array lint)
 lint_top de_span_video $(files span_video lint)
 # sim/fast: the fast array's pieces and its DPI shell (simulation wiring around the same

@@ -119,8 +119,8 @@ module ulx3s_top (
   logic            hsync, vsync, blank;
   /* verilator lint_on UNUSEDSIGNAL */
 
-  logic [15:0] sd_dq_o, sd_dq_i;
-  logic        sd_dq_oe;
+  de_sdram_pkg::sdram_out_t sd;
+  logic [15:0] sd_dq_i;
 
   de_board_core u_core (
     .clk_i    (clk_pix),
@@ -136,23 +136,22 @@ module ulx3s_top (
     .hsync_o  (hsync),
     .vsync_o  (vsync),
     .blank_o  (blank),
-    .sd_cke_o  (sdram_cke),
-    .sd_cs_n_o (sdram_csn),
-    .sd_ras_n_o(sdram_rasn),
-    .sd_cas_n_o(sdram_casn),
-    .sd_we_n_o (sdram_wen),
-    .sd_ba_o   (sdram_ba),
-    .sd_a_o    (sdram_a),
-    .sd_dqm_o  (sdram_dqm),
-    .sd_dq_o   (sd_dq_o),
-    .sd_dq_oe_o(sd_dq_oe),
+    .sd_o     (sd),
     .sd_dq_i   (sd_dq_i)
   );
   assign led = led_core;
 
   // ------------------------------------------------------------------ SDRAM pins
+  assign sdram_cke  = sd.cke;
+  assign sdram_csn  = sd.cs_n;
+  assign sdram_rasn = sd.ras_n;
+  assign sdram_casn = sd.cas_n;
+  assign sdram_wen  = sd.we_n;
+  assign sdram_ba   = sd.ba;
+  assign sdram_a    = sd.a;
+  assign sdram_dqm  = sd.dqm;
   for (genvar i = 0; i < 16; i++) begin : g_dq
-    BB u_bb (.I(sd_dq_o[i]), .T(~sd_dq_oe), .O(sd_dq_i[i]), .B(sdram_d[i]));
+    BB u_bb (.I(sd.dq[i]), .T(~sd.dq_oe), .O(sd_dq_i[i]), .B(sdram_d[i]));
   end
   ODDRX1F u_sdram_clk (.SCLK(clk_shift), .RST(1'b0), .D0(1'b0), .D1(1'b1), .Q(sdram_clk));
 

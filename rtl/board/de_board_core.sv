@@ -60,16 +60,7 @@ module de_board_core #(
   output logic            vsync_o,
   output logic            blank_o,
   // SDRAM (clk_sdram_i; docs/sdram-frames-spec.md §4): DQ split for the I/O buffer.
-  output logic            sd_cke_o,
-  output logic            sd_cs_n_o,
-  output logic            sd_ras_n_o,
-  output logic            sd_cas_n_o,
-  output logic            sd_we_n_o,
-  output logic [1:0]      sd_ba_o,
-  output logic [12:0]     sd_a_o,
-  output logic [1:0]      sd_dqm_o,
-  output logic [15:0]     sd_dq_o,
-  output logic            sd_dq_oe_o,
+  output de_sdram_pkg::sdram_out_t sd_o,
   input  logic [15:0]     sd_dq_i
 );
   localparam int unsigned NumCh = 3;
@@ -157,8 +148,7 @@ module de_board_core #(
     .malformed_o   (malformed),
     .late_o        (late_words),
     .sd_init_done_o(sd_init_done),
-    .sd_cke_o, .sd_cs_n_o, .sd_ras_n_o, .sd_cas_n_o, .sd_we_n_o, .sd_ba_o, .sd_a_o,
-    .sd_dqm_o, .sd_dq_o, .sd_dq_oe_o, .sd_dq_i
+    .sd_o, .sd_dq_i
   );
   // ------------------------------------------------------------------ display controller
   /* verilator lint_off UNUSEDSIGNAL */

@@ -27,8 +27,8 @@
 module de_sdram_ctrl #(
   parameter int unsigned TckPs      = 8000,     // 125 MHz
   parameter int unsigned CasLatency = 3,
-  parameter int unsigned BankBits   = 2,
-  parameter int unsigned RowBits    = 13,
+  parameter int unsigned BankBits   = de_sdram_pkg::SdBankBits,   // the pins' widths:
+  parameter int unsigned RowBits    = de_sdram_pkg::SdRowBits,    // checked below
   parameter int unsigned ColBits    = 9,
   // Timings of the part, picoseconds (MT48LC16M16A2-6A).
   parameter int unsigned TrcdPs     = 18000,
@@ -65,18 +65,9 @@ module de_sdram_ctrl #(
   // Status.
   output logic                init_done_o,
   output logic                refresh_o,      // one clock per AUTO REFRESH issued
-  // SDRAM pins (registered).
-  output logic                sd_cke_o,
-  output logic                sd_cs_n_o,
-  output logic                sd_ras_n_o,
-  output logic                sd_cas_n_o,
-  output logic                sd_we_n_o,
-  output logic [BankBits-1:0] sd_ba_o,
-  output logic [PinAW-1:0]    sd_a_o,
-  output logic [1:0]          sd_dqm_o,
-  output logic [15:0]         sd_dq_o,
-  output logic                sd_dq_oe_o,
-  input  logic [15:0]         sd_dq_i
+  // SDRAM pins (registered; de_sdram_pkg).
+  output de_sdram_pkg::sdram_out_t sd_o,
+  input  logic [de_sdram_pkg::SdDqW-1:0] sd_dq_i
 );
   // ---------------------------------------------------------------- parameter checks
   if (CasLatency != 2 && CasLatency != 3) begin : g_bad_cl
@@ -84,6 +75,10 @@ module de_sdram_ctrl #(
   end
   if (RowBits < ColBits + 2 || RowBits < 11 || ColBits < 8) begin : g_bad_geom
     $fatal(1, "de_sdram_ctrl: RowBits >= ColBits + 2 (A10 and the column share the pins)");
+  end
+  if (BankBits != de_sdram_pkg::SdBankBits || RowBits != de_sdram_pkg::SdRowBits)
+      begin : g_bad_pins
+    $fatal(1, "de_sdram_ctrl: BankBits / RowBits must match the pins of de_sdram_pkg");
   end
   if (TckPs < 5000) begin : g_bad_tck
     $fatal(1, "de_sdram_ctrl: TckPs >= 5000");
@@ -635,16 +630,16 @@ module de_sdram_ctrl #(
     end
   end
 
-  assign sd_cke_o    = cke_q;
-  assign sd_cs_n_o   = cmd_q[3];
-  assign sd_ras_n_o  = cmd_q[2];
-  assign sd_cas_n_o  = cmd_q[1];
-  assign sd_we_n_o   = cmd_q[0];
-  assign sd_ba_o     = ba_q;
-  assign sd_a_o      = a_q;
-  assign sd_dqm_o    = 2'b00;
-  assign sd_dq_o     = dq_q;
-  assign sd_dq_oe_o  = dq_oe_q;
+  assign sd_o.cke   = cke_q;
+  assign sd_o.cs_n  = cmd_q[3];
+  assign sd_o.ras_n = cmd_q[2];
+  assign sd_o.cas_n = cmd_q[1];
+  assign sd_o.we_n  = cmd_q[0];
+  assign sd_o.ba    = ba_q;
+  assign sd_o.a     = a_q;
+  assign sd_o.dqm   = '0;
+  assign sd_o.dq    = dq_q;
+  assign sd_o.dq_oe = dq_oe_q;
   assign rd_valid_o  = rdv_q;
   assign rd_data_o   = rdd_q;
   assign rd_tag_o    = rdt_q;

@@ -78,16 +78,7 @@ module de_sdram_frames #(
   output logic [7:0]       late_o,           // late lines for want of data (saturating)
   output logic             sd_init_done_o,
   // SDRAM pins (SDRAM clock; docs/sdram-frames-spec.md §4).
-  output logic             sd_cke_o,
-  output logic             sd_cs_n_o,
-  output logic             sd_ras_n_o,
-  output logic             sd_cas_n_o,
-  output logic             sd_we_n_o,
-  output logic [1:0]       sd_ba_o,
-  output logic [12:0]      sd_a_o,
-  output logic [1:0]       sd_dqm_o,
-  output logic [15:0]      sd_dq_o,
-  output logic             sd_dq_oe_o,
+  output de_sdram_pkg::sdram_out_t sd_o,
   input  logic [15:0]      sd_dq_i
 );
   if (PfDepth < 16 || PfDepth > 8192 || (PfDepth & (PfDepth - 1)) != 0) begin : g_bad_pf
@@ -527,8 +518,7 @@ module de_sdram_frames #(
     .rd_last_o     (ctl_rd_last),
     .init_done_o   (sd_init_done_o),
     .refresh_o     (ctl_refresh),
-    .sd_cke_o, .sd_cs_n_o, .sd_ras_n_o, .sd_cas_n_o, .sd_we_n_o, .sd_ba_o, .sd_a_o,
-    .sd_dqm_o, .sd_dq_o, .sd_dq_oe_o, .sd_dq_i
+    .sd_o, .sd_dq_i
   );
 
   // ---------------------------------------------------------------- info FIFO

@@ -7,7 +7,7 @@
 // de_array: a Refresh on id_i in the cycle ending with edge E puts column q on
 // pix_o right after edge E + Latency - 1 + q (de_array: Latency = NumChips + 3).
 //
-//   id_i/data_i ─► de_afifo ─► de_span_array ─► line buffer ─► read out Latency after
+//   id_i/data_i ─► de_async_fifo ─► de_span_array ─► line buffer ─► read out Latency after
 //   (pixel clock)     (to core)   (core clock)     (NumLineBuf     each Refresh, one
 //                                                   lines)          column per pixel clock
 //
@@ -62,24 +62,32 @@ module de_span_video
   logic rst_c1_q, rst_c2_q;                  // rst_i synchronised to the core clock
   logic              fvalid, fready, cready;
   logic [IdW+DataW-1:0] fword;
-  // A two-entry skid buffer between the FIFO and the array: the FIFO's read (distributed
+  // A two-entry skid buffer between the FIFO and the array: the FIFO's read (block
   // RAM) ends in a register, and the FIFO's read enable depends on the buffer's count
   // only, not on the array's ready (its front-end decode).
   logic              cvalid;
   logic [IdW+DataW-1:0] cword;
 
-  de_afifo #(.W(IdW + DataW), .AW(FifoAw)) u_fifo (
+  // The board's dual-clock FIFO (rtl/prim): 2^FifoAw words of block RAM with a registered
+  // show-ahead read. The bus writes every clock; full only raises the sticky overflow.
+  logic fifo_wready;
+  /* verilator lint_off UNUSEDSIGNAL */  // free count: the bus cannot wait, full is an error
+  logic [FifoAw:0] fifo_wfree;
+  /* verilator lint_on UNUSEDSIGNAL */
+  de_async_fifo #(.Width(IdW + DataW), .Depth(1 << FifoAw)) u_fifo (
     .wclk_i  (clk_i),
     .wrst_i  (rst_i),
     .wvalid_i(!rst_i),
+    .wready_o(fifo_wready),
     .wdata_i ({id_i, data_i}),
-    .wfull_o (fifo_full),
+    .wfree_o (fifo_wfree),
     .rclk_i  (clk_core_i),
     .rrst_i  (rst_c2_q),
     .rvalid_o(fvalid),
     .rready_i(fready),
     .rdata_o (fword)
   );
+  assign fifo_full = !fifo_wready;
   de_skid #(.W(IdW + DataW)) u_skid (
     .clk_i  (clk_core_i),
     .rst_i  (rst_c2_q),

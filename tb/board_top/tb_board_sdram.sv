@@ -1,6 +1,6 @@
 // Test top for tb/board_top/test_board_top.py::test_board: the board core
 // rtl/board/de_board_core.sv with the timing-checking SDRAM model sim/models/sdram_sdr16.sv
-// on its SDRAM pins, as on the board (the I/O buffer joins sd_dq_o / sd_dq_oe_o and the
+// on its SDRAM pins, as on the board (the I/O buffer joins sd_o.dq / sd_o.dq_oe and the
 // model's dq_o / dq_oe_o at the DQ pins, as tb/de_sdram_ctrl/tb_sdram_ctrl.sv does).
 // The core's parameters pass through; SdTinitNs shortens the power-up wait of both the
 // controller and the model. err_count_o: the model's timing violations.
@@ -44,10 +44,9 @@ module tb_board_sdram #(
   output      logic [31:0]     err_count_o,
   output      logic [31:0]     ref_count_o
 );
-  logic        cke, cs_n, ras_n, cas_n, we_n, c_oe, m_oe;
-  logic [1:0]  ba, dqm;
-  logic [12:0] a;
-  logic [15:0] c_dq, m_dq, bus;
+  de_sdram_pkg::sdram_out_t sd;
+  logic        m_oe;
+  logic [15:0] m_dq, bus;
 
   de_board_core #(
     .NumChips(NumChips), .CarryBug(CarryBug), .PfDepth(PfDepth), .SdTckPs(8000),
@@ -59,13 +58,11 @@ module tb_board_sdram #(
   ) u_core (
     .clk_i, .clk_core_i, .clk_sdram_i, .rst_i, .mode_i, .uart_rx_i, .uart_tx_o, .tmds_o,
     .led_o, .rgb8_o, .hsync_o, .vsync_o, .blank_o,
-    .sd_cke_o(cke), .sd_cs_n_o(cs_n), .sd_ras_n_o(ras_n), .sd_cas_n_o(cas_n),
-    .sd_we_n_o(we_n), .sd_ba_o(ba), .sd_a_o(a), .sd_dqm_o(dqm),
-    .sd_dq_o(c_dq), .sd_dq_oe_o(c_oe), .sd_dq_i(bus)
+    .sd_o(sd), .sd_dq_i(bus)
   );
 
   // The DQ pins: whoever drives; both at once is the model's DQ violation (and X here).
-  assign bus = c_oe ? c_dq : (m_oe ? m_dq : 16'hzzzz);
+  assign bus = sd.dq_oe ? sd.dq : (m_oe ? m_dq : 16'hzzzz);
 
   logic [15:0] err_seen;
   logic [3:0]  err_code;
@@ -76,8 +73,9 @@ module tb_board_sdram #(
 
   sdram_sdr16 #(.TckPs(8000), .TinitNs(SdTinitNs)) u_sdram (
     .clk_i(clk_sdram_i), .rst_i,
-    .cke_i(cke), .cs_n_i(cs_n), .ras_n_i(ras_n), .cas_n_i(cas_n), .we_n_i(we_n),
-    .ba_i(ba), .a_i(a), .dqm_i(dqm), .dq_i(c_dq), .dq_o(m_dq), .dq_oe_o(m_oe),
+    .cke_i(sd.cke), .cs_n_i(sd.cs_n), .ras_n_i(sd.ras_n), .cas_n_i(sd.cas_n),
+    .we_n_i(sd.we_n), .ba_i(sd.ba), .a_i(sd.a), .dqm_i(sd.dqm), .dq_i(sd.dq), .dq_o(m_dq),
+    .dq_oe_o(m_oe),
     .err_count_o, .err_seen_o(err_seen), .err_code_o(err_code), .cycle_o(cycle),
     .init_done_o(init_done_m), .ref_count_o, .cl_o(cl_m), .bl_o(bl_m)
   );

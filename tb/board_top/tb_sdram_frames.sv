@@ -27,10 +27,9 @@ module tb_sdram_frames #(
   output      logic [31:0]      err_count_o,
   output      logic [31:0]      ref_count_o
 );
-  logic        cke, cs_n, ras_n, cas_n, we_n, c_oe, m_oe;
-  logic [1:0]  ba, dqm;
-  logic [12:0] a;
-  logic [15:0] c_dq, m_dq, bus;
+  de_sdram_pkg::sdram_out_t sd;
+  logic        m_oe;
+  logic [15:0] m_dq, bus;
   logic [2:0][47:0] wr_data;
   logic        frame;
 
@@ -38,15 +37,13 @@ module tb_sdram_frames #(
     .clk_i, .rst_i, .clk_sdram_i, .vactive_i, .cmd_valid_i, .cmd_ready_o, .cmd_i,
     .wr_valid_o, .wr_ready_i, .wr_data_o(wr_data), .dc_late_i(3'b000),
     .frame_o(frame), .q_pending_o, .malformed_o, .late_o, .sd_init_done_o,
-    .sd_cke_o(cke), .sd_cs_n_o(cs_n), .sd_ras_n_o(ras_n), .sd_cas_n_o(cas_n),
-    .sd_we_n_o(we_n), .sd_ba_o(ba), .sd_a_o(a), .sd_dqm_o(dqm),
-    .sd_dq_o(c_dq), .sd_dq_oe_o(c_oe), .sd_dq_i(bus)
+    .sd_o(sd), .sd_dq_i(bus)
   );
 
   assign take_o      = u_fr.pf_take & u_fr.pf_rvalid;
   assign take_data_o = u_fr.pf_rdata;
 
-  assign bus = c_oe ? c_dq : (m_oe ? m_dq : 16'hzzzz);
+  assign bus = sd.dq_oe ? sd.dq : (m_oe ? m_dq : 16'hzzzz);
 
   logic [15:0] err_seen;
   logic [3:0]  err_code;
@@ -57,8 +54,9 @@ module tb_sdram_frames #(
 
   sdram_sdr16 #(.TckPs(8000), .TinitNs(SdTinitNs)) u_sdram (
     .clk_i(clk_sdram_i), .rst_i,
-    .cke_i(cke), .cs_n_i(cs_n), .ras_n_i(ras_n), .cas_n_i(cas_n), .we_n_i(we_n),
-    .ba_i(ba), .a_i(a), .dqm_i(dqm), .dq_i(c_dq), .dq_o(m_dq), .dq_oe_o(m_oe),
+    .cke_i(sd.cke), .cs_n_i(sd.cs_n), .ras_n_i(sd.ras_n), .cas_n_i(sd.cas_n),
+    .we_n_i(sd.we_n), .ba_i(sd.ba), .a_i(sd.a), .dqm_i(sd.dqm), .dq_i(sd.dq), .dq_o(m_dq),
+    .dq_oe_o(m_oe),
     .err_count_o, .err_seen_o(err_seen), .err_code_o(err_code), .cycle_o(cycle),
     .init_done_o(init_done_m), .ref_count_o, .cl_o(cl_m), .bl_o(bl_m)
   );

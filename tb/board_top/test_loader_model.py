@@ -19,7 +19,6 @@ import sys
 from pathlib import Path
 
 import cocotb
-from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
 HERE = Path(__file__).resolve().parent
@@ -67,23 +66,13 @@ def random_command(rng: random.Random) -> tuple[str, bytes]:
 
 @cocotb.test()
 async def test_model_equals_rtl(dut):
-    from common.run import seed_from_env
+    from common.run import hold_reset, seed_from_env
     rng = random.Random(seed_from_env())
     tmo = 1 << int(dut.TimeoutBits.value)
-    cocotb.start_soon(Clock(dut.clk_i, 10, unit="ns").start())
-    for s in ("rx_valid_i", "rx_ferr_i", "frame_i", "align_err_i"):
-        getattr(dut, s).value = 0
-    dut.rx_data_i.value = 0
-    dut.pending_i.value = 0
-    dut.pix_collision_i.value = 0
-    dut.sd_cmd_ready_i.value = 1
-    dut.malformed_i.value = 0
-    dut.late_i.value = 0
-    dut.reg_rdata_i.value = REG
-    dut.tx_ready_i.value = 1
-    dut.rst_i.value = 1
-    await ClockCycles(dut.clk_i, 3)
-    dut.rst_i.value = 0
+    await hold_reset(dut, 3, falling=False, clock_ns=10,
+                     rx_valid_i=0, rx_ferr_i=0, frame_i=0, align_err_i=0, rx_data_i=0,
+                     pending_i=0, pix_collision_i=0, sd_cmd_ready_i=1, malformed_i=0, late_i=0,
+                     reg_rdata_i=REG, tx_ready_i=1)
 
     model = LoaderModel(regs={a: REG for a in range(1 << 14)})
     rtl_mem: list[dict] = [{}, {}, {}]

@@ -78,6 +78,12 @@ def seed_from_env(default: int | None = None) -> int:
     return seed
 
 
+def drive(dut, **values) -> None:
+    """Set the testbench's inputs: drive(dut, rst_i=1, valid_i=0, ...) (name=value)."""
+    for name, value in values.items():
+        getattr(dut, name).value = value
+
+
 async def hold_reset(dut, rises: int, *, falling: bool = True, clock_ns: float | None = None,
                      **inputs) -> None:
     """The testbenches' reset: optionally start a clock_ns clock on clk_i, raise rst_i
@@ -88,9 +94,7 @@ async def hold_reset(dut, rises: int, *, falling: bool = True, clock_ns: float |
     from cocotb.triggers import FallingEdge, RisingEdge
     if clock_ns is not None:
         cocotb.start_soon(Clock(dut.clk_i, clock_ns, unit="ns").start())
-    dut.rst_i.value = 1
-    for name, value in inputs.items():
-        getattr(dut, name).value = value
+    drive(dut, rst_i=1, **inputs)
     for _ in range(rises):
         await RisingEdge(dut.clk_i)
     if falling:

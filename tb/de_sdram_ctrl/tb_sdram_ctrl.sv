@@ -1,6 +1,6 @@
 // Test top for tb/de_sdram_ctrl: the controller rtl/board/de_sdram_ctrl.sv driving the
 // timing-checking model sim/models/sdram_sdr16.sv over the SDRAM pins, as on the board
-// (the board's I/O buffer joins sd_dq_o / sd_dq_oe_o / dq_o at the DQ pins).
+// (the board's I/O buffer joins sd_o.dq / sd_o.dq_oe / dq_o at the DQ pins).
 `default_nettype none
 
 module tb_sdram_ctrl #(
@@ -31,10 +31,9 @@ module tb_sdram_ctrl #(
   output      logic [31:0]   ref_count_o,
   output      logic [31:0]   cycle_o
 );
-  logic        cke, cs_n, ras_n, cas_n, we_n, c_oe, m_oe;
-  logic [1:0]  ba, dqm;
-  logic [12:0] a;
-  logic [15:0] c_dq, m_dq, bus;
+  de_sdram_pkg::sdram_out_t sd;
+  logic        m_oe;
+  logic [15:0] m_dq, bus;
 
   de_sdram_ctrl #(.TckPs(TckPs), .CasLatency(CasLatency), .TinitNs(TinitNs)) u_ctrl (
     .clk_i, .rst_i,
@@ -42,13 +41,11 @@ module tb_sdram_ctrl #(
     .rd_req_valid_i, .rd_req_ready_o, .rd_req_addr_i, .rd_req_tag_i,
     .rd_valid_o, .rd_data_o, .rd_tag_o, .rd_last_o,
     .init_done_o, .refresh_o,
-    .sd_cke_o(cke), .sd_cs_n_o(cs_n), .sd_ras_n_o(ras_n), .sd_cas_n_o(cas_n),
-    .sd_we_n_o(we_n), .sd_ba_o(ba), .sd_a_o(a), .sd_dqm_o(dqm),
-    .sd_dq_o(c_dq), .sd_dq_oe_o(c_oe), .sd_dq_i(bus)
+    .sd_o(sd), .sd_dq_i(bus)
   );
 
   // The DQ pins: whoever drives; both at once is the model's DQ violation (and X here).
-  assign bus = c_oe ? c_dq : (m_oe ? m_dq : 16'hzzzz);
+  assign bus = sd.dq_oe ? sd.dq : (m_oe ? m_dq : 16'hzzzz);
 
   logic [15:0] err_seen;
   logic        init_done_m;
@@ -57,8 +54,9 @@ module tb_sdram_ctrl #(
 
   sdram_sdr16 #(.TckPs(TckPs), .TinitNs(TinitNs)) u_sdram (
     .clk_i, .rst_i,
-    .cke_i(cke), .cs_n_i(cs_n), .ras_n_i(ras_n), .cas_n_i(cas_n), .we_n_i(we_n),
-    .ba_i(ba), .a_i(a), .dqm_i(dqm), .dq_i(c_dq), .dq_o(m_dq), .dq_oe_o(m_oe),
+    .cke_i(sd.cke), .cs_n_i(sd.cs_n), .ras_n_i(sd.ras_n), .cas_n_i(sd.cas_n),
+    .we_n_i(sd.we_n), .ba_i(sd.ba), .a_i(sd.a), .dqm_i(sd.dqm), .dq_i(sd.dq), .dq_o(m_dq),
+    .dq_oe_o(m_oe),
     .err_count_o, .err_seen_o(err_seen), .err_code_o, .cycle_o,
     .init_done_o(init_done_m), .ref_count_o, .cl_o(cl_m), .bl_o(bl_m)
   );

@@ -31,6 +31,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
+from common.run import drive  # noqa: E402
 
 try:
     import cocotb
@@ -59,13 +60,8 @@ class Bench:
 
     async def start(self) -> None:
         dut = self.dut
-        dut.rst_i.value = 1
-        dut.wr_valid_i.value = 0
-        dut.rd_req_valid_i.value = 0
-        dut.wr_addr_i.value = 0
-        dut.wr_data_i.value = 0
-        dut.rd_req_addr_i.value = 0
-        dut.rd_req_tag_i.value = 0
+        drive(dut, rst_i=1, wr_valid_i=0, rd_req_valid_i=0, wr_addr_i=0, wr_data_i=0,
+              rd_req_addr_i=0, rd_req_tag_i=0)
         Clock(dut.clk_i, TCK_PS, unit="ps").start(start_high=False)
         for _ in range(3):
             await FallingEdge(dut.clk_i)

@@ -30,6 +30,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 sys.path.insert(0, str(HERE.parent))
+from common.run import drive  # noqa: E402
 
 try:  # the pytest runner part does not need cocotb's simulator side
     import cocotb
@@ -125,14 +126,8 @@ class Sdram:
     async def power_on(self) -> None:
         dut = self.dut
         await FallingEdge(dut.clk_i)
-        dut.rst_i.value = 1
-        for name in ("cs_n_i", "ras_n_i", "cas_n_i", "we_n_i"):
-            getattr(dut, name).value = 1
-        dut.cke_i.value = 1
-        dut.ba_i.value = 0
-        dut.a_i.value = 0
-        dut.dqm_i.value = 0
-        dut.dq_i.value = 0
+        drive(dut, rst_i=1, cs_n_i=1, ras_n_i=1, cas_n_i=1, we_n_i=1, cke_i=1, ba_i=0, a_i=0,
+              dqm_i=0, dq_i=0)
         await FallingEdge(dut.clk_i)
         await FallingEdge(dut.clk_i)
         dut.rst_i.value = 0

@@ -13,24 +13,6 @@
 #include "yp_internal.h"
 #include "yp_fixture.h"
 
-typedef struct ta { yp_anim *an; hsr_scene *sc; yp_shader *sh; hsr_ctx *h; yp_frame *fr; yp_options o; int W, H; } ta;
-
-static int ta_open(ta *t, const char *path)
-{
-    memset(t, 0, sizeof *t);
-    char err[256] = "";
-    double *shade;
-    yp_options_default(&t->o);
-    if (yp_anim_load(path, &t->an, err, sizeof err) != HSR_OK) { fprintf(stderr, "%s\n", err); return 0; }
-    t->sc = yp_anim_scene(t->an);
-    t->W = t->sc->width; t->H = t->sc->height;
-    if (yp_anim_apply(t->an, 0, NULL, NULL, NULL, NULL) != HSR_OK || yp_shader_new(t->sc, YP_PHONG, &t->sh, err, sizeof err) != HSR_OK
-        || yp_anim_apply(t->an, 0, NULL, t->sh, NULL, NULL) != HSR_OK || hsr_scene_build(t->sc, &t->h, &shade) != HSR_OK) return 0;
-    free(shade);
-    return yp_frame_new(t->W, t->H, &t->fr) == HSR_OK;
-}
-
-static void ta_close(ta *t) { yp_frame_free(t->fr); hsr_destroy(t->h); yp_shader_free(t->sh); yp_anim_free(t->an); }
 
 static int max_slots(const yp_frame *fr, int y)
 {
@@ -57,7 +39,7 @@ static int late_lines(const yp_frame *fr, int cap, int *iss, int *late)
 }
 
 /* 1 if fr equals a full rebuild of the scene as it is now at the same options */
-static int equals_full(ta *t, const yp_options *o)
+static int equals_full(ypt_anim *t, const yp_options *o)
 {
     hsr_ctx *hf;
     double *shade;
@@ -79,9 +61,8 @@ static int equals_full(ta *t, const yp_options *o)
 static void test_lod_fit_no_late_line_from_frame_0_and_quality_back(void)
 {
     ypt_grid_anim("tf", 24);
-    ta t;
-    CHECK(ta_open(&t, "build/tf_grid.anim"));
-    if (!t.fr) { ta_close(&t); return; }
+    ypt_anim t;
+    if (!ypt_anim_start(&t, "build/tf_grid.anim", 1)) return;
     int H = t.H;
     yp_options o = t.o;
     CHECK(yp_scan(t.sh, t.h, &o, 0, H, t.fr) == HSR_OK);
@@ -113,7 +94,7 @@ static void test_lod_fit_no_late_line_from_frame_0_and_quality_back(void)
     CHECK(over > 0 && lowered0 == over);                  /* exactly the lines over the capacity */
     CHECK(mean == YP_LOD_MAX);                            /* the grid gone: full quality again */
     yp_lod_free(lod);
-    ta_close(&t);
+    ypt_anim_close(&t);
 }
 
 /* A dense mesh: a 40 x 30 grid of triangles (2,400 faces) on a wavy sheet in front of a
@@ -142,13 +123,21 @@ static const char *make_sheet(void)
     return "build/ts.scene";
 }
 
+/* the sheet scene and an animation of it (path, the lines after its scene line), opened at
+ * frame 0 (ypt_anim_start) */
+static int sheet_start(ypt_anim *t, const char *path, const char *anim)
+{
+    char text[512];
+    make_sheet();
+    snprintf(text, sizeof text, "scene ts.scene\n%s", anim);
+    ypt_write_file(path, text);
+    return ypt_anim_start(t, path, 1);
+}
+
 static void test_tessellation_versions_cluster_and_switch_incrementally(void)
 {
-    make_sheet();
-    ypt_write_file("build/ts.anim", "scene ts.scene\nframes 4\ntessellation 1 0.25 3\nmove 1 0.3 0 0 from 1 to 3\n");
-    ta t;
-    CHECK(ta_open(&t, "build/ts.anim"));
-    if (!t.fr) { ta_close(&t); return; }
+    ypt_anim t;
+    if (!sheet_start(&t, "build/ts.anim", "frames 4\ntessellation 1 0.25 3\nmove 1 0.3 0 0 from 1 to 3\n")) return;
     yp_tess *ts = yp_anim_tess(t.an);
     CHECK(yp_tess_count(ts) == 1 && yp_tess_versions(ts, 0) == 3 && yp_tess_get(ts, 0) == 0);
     CHECK(yp_tess_obj(ts, 0, 0) == 1 && yp_tess_obj(ts, 0, 1) == 2 && yp_tess_obj(ts, 0, 2) == 3);
@@ -189,7 +178,7 @@ static void test_tessellation_versions_cluster_and_switch_incrementally(void)
     CHECK(yp_anim_load("build/ts_bad.anim", &bad, err, sizeof err) == HSR_EPARSE && strstr(err, "ts_bad.anim:2:"));
     ypt_write_file("build/ts_bad.anim", "scene ts.scene\ntessellation 1 0.25 9\n");
     CHECK(yp_anim_load("build/ts_bad.anim", &bad, err, sizeof err) == HSR_EPARSE && strstr(err, "VERSIONS"));
-    ta_close(&t);
+    ypt_anim_close(&t);
 }
 
 /* The sheet with a capacity that its lines do not fit even at level 0, but its clustered
@@ -198,11 +187,8 @@ static void test_tessellation_versions_cluster_and_switch_incrementally(void)
  * back to the finer mesh without a late line; every frame equals its full rebuild. */
 static void test_tessellation_loop_coarser_when_overloaded_finer_when_load_falls(void)
 {
-    make_sheet();
-    ypt_write_file("build/ts_loop.anim", "scene ts.scene\nframes 24\ntessellation 1 0.25 3\nmove 1 3.6 0 0 from 4 to 8\n");
-    ta t;
-    CHECK(ta_open(&t, "build/ts_loop.anim"));
-    if (!t.fr) { ta_close(&t); return; }
+    ypt_anim t;
+    if (!sheet_start(&t, "build/ts_loop.anim", "frames 24\ntessellation 1 0.25 3\nmove 1 3.6 0 0 from 4 to 8\n")) return;
     yp_tess *ts = yp_anim_tess(t.an);
     int H = t.H, iss[128], late[128];
     yp_options o = t.o;
@@ -237,7 +223,7 @@ static void test_tessellation_loop_coarser_when_overloaded_finer_when_load_falls
     CHECK(ver[0] > 0 && ver[3] > 0);     /* coarser while the whole sheet is in view */
     CHECK(ver[23] < ver[3]);             /* finer again once its lines are short */
     yp_lod_free(lod);
-    ta_close(&t);
+    ypt_anim_close(&t);
 }
 
 

@@ -24,44 +24,11 @@ static void make_pattern_files(void)
     ypt_write_file("build/t_tex.anim", PATTERN_ANIM);
 }
 
-/* an animation at frame 0: scene, Phong shader (without the .anim's point lights and
- * textures unless ext), HSR built, a frame, default options */
-typedef struct tanim { yp_anim *an; hsr_scene *sc; yp_shader *sh; hsr_ctx *h; yp_frame *fr; yp_options o; int W, H; } tanim;
-
-static void tanim_close(tanim *t)
-{
-    yp_frame_free(t->fr); hsr_destroy(t->h); yp_shader_free(t->sh); yp_anim_free(t->an);
-}
-
-static int tanim_make(tanim *t, const char *path, int ext)
-{
-    memset(t, 0, sizeof *t);
-    char err[256] = "";
-    double *shade;
-    yp_options_default(&t->o);
-    if (yp_anim_load(path, &t->an, err, sizeof err) != HSR_OK) { fprintf(stderr, "%s\n", err); return 0; }
-    t->sc = yp_anim_scene(t->an);
-    t->W = t->sc->width; t->H = t->sc->height;
-    if (yp_anim_apply(t->an, 0, NULL, NULL, NULL, NULL) != HSR_OK || yp_shader_new(t->sc, YP_PHONG, &t->sh, err, sizeof err) != HSR_OK
-        || (ext && yp_anim_apply(t->an, 0, NULL, t->sh, NULL, NULL) != HSR_OK) || hsr_scene_build(t->sc, &t->h, &shade) != HSR_OK) return 0;
-    free(shade);
-    return yp_frame_new(t->W, t->H, &t->fr) == HSR_OK;
-}
-
-/* tanim_make, a test failure when it fails (and what it made freed): 0 then. */
-static int tanim_open(tanim *t, const char *path, int ext)
-{
-    const int ok = tanim_make(t, path, ext);
-    CHECK(ok);
-    if (!ok) tanim_close(t);
-    return ok;
-}
-
 static void test_texture_is_c1_piecewise_quadratic_along_u(void)
 {
     make_pattern_files();
-    tanim ta;
-    if (!tanim_open(&ta, "build/t_tex.anim", 1)) return;
+    ypt_anim ta;
+    if (!ypt_anim_start(&ta, "build/t_tex.anim", 1)) return;
     yp_shader *sh = ta.sh;
     char err[256] = "";
     CHECK(yp_texture_at(sh, 0, (double[3]){0, 0, 0}) >= 0);
@@ -94,7 +61,7 @@ static void test_texture_is_c1_piecewise_quadratic_along_u(void)
     yp_texture big = {0.3, 0.9, {1, 1, 1}, 1, 8};
     CHECK(yp_shader_set_texture(sh, 1, &big, err, sizeof err) == HSR_EPARSE);
     CHECK(strstr(err, "exceed intensity 1") != NULL);
-    tanim_close(&ta);
+    ypt_anim_close(&ta);
 }
 
 static void test_point_light_brightest_under_it_and_follows_it(void)
@@ -134,8 +101,8 @@ static void test_wander_moves_continuously_towards_random_points_in_its_box(void
     make_pattern_files();
     ypt_write_file("build/t_w.anim", "scene t_tex.scene\nframes 40\npointlight 0 0.4 0.3 0.9\n"
                "wander 0 99 5 -1.8 -1.3 0.5 1.8 1.3 1.2 from 0 to 39\n");
-    tanim ta;
-    if (!tanim_open(&ta, "build/t_w.anim", 1)) return;
+    ypt_anim ta;
+    if (!ypt_anim_start(&ta, "build/t_w.anim", 1)) return;
     yp_anim *an = ta.an;
     yp_shader *sh = ta.sh;
     char err[256] = "";
@@ -164,7 +131,7 @@ static void test_wander_moves_continuously_towards_random_points_in_its_box(void
     /* the same frame again: the same place (frames can be applied in any order) */
     CHECK(yp_anim_apply(an, 17, NULL, sh, NULL, NULL) == HSR_OK);
     CHECK(!memcmp(sh->Lpos[0], p[17], sizeof p[17]));
-    tanim_close(&ta);
+    ypt_anim_close(&ta);
     an = NULL;
     /* errors name the file and line */
     ypt_write_file("build/t_w2.anim", "scene t_tex.scene\nframes 4\nwander 0 1 2 0 0 0 1 1 1 from 0 to 3\n");
@@ -220,9 +187,9 @@ static double frame_worst(const yp_frame *fr)
  * (LCS), the slots of all frames and the worst pixel against the exact shading. */
 static void textured_run(const char *path, double tol, int coherent, long *changed, long *total, double *worst)
 {
-    tanim t;
+    ypt_anim t;
     *changed = *total = 0; *worst = 0;
-    if (!tanim_open(&t, path, 1)) return;
+    if (!ypt_anim_start(&t, path, 1)) return;
     int H = t.H, W = t.W;
     double *shade;
     t.o.tol = tol; t.o.coherent = coherent;
@@ -255,14 +222,14 @@ static void textured_run(const char *path, double tol, int coherent, long *chang
     }
     for (int i = 0; prev && i < 3 * H; i++) yp_cmdlist_free(&prev[i]);
     free(prev);
-    tanim_close(&t);
+    ypt_anim_close(&t);
 }
 
 static void test_textured_anim_changes_only_the_light_terms(void)
 {
     make_pattern_files();
-    tanim t;
-    if (!tanim_open(&t, "build/t_tex.anim", 0)) return;
+    ypt_anim t;
+    if (!ypt_anim_start(&t, "build/t_tex.anim", 0)) return;
     yp_frame *fr = t.fr, *plain = NULL;
     int H = t.H, W = t.W;
     CHECK(yp_frame_new(W, H, &plain) == HSR_OK);
@@ -275,7 +242,7 @@ static void test_textured_anim_changes_only_the_light_terms(void)
     /* the frame is within the fit's bound of the exact target (texture included) */
     CHECK(frame_worst(fr) <= 0.5 + 4 * t.o.tol + 0.05);
     yp_frame_free(plain);
-    tanim_close(&t);
+    ypt_anim_close(&t);
     double worst;
     textured_run("build/t_tex.anim", 1, 0, &changed, &total, &worst);
     CHECK(changed > 0);
@@ -355,8 +322,8 @@ static void test_lod_update_lowers_late_lines_and_raises_when_load_falls(void)
 static void test_lod_loop_removes_overflow_and_restores_quality(void)
 {
     ypt_grid_anim("t", 14);
-    tanim t;
-    if (!tanim_open(&t, "build/t_grid.anim", 1)) return;
+    ypt_anim t;
+    if (!ypt_anim_start(&t, "build/t_grid.anim", 1)) return;
     yp_shader *sh = t.sh;
     hsr_ctx *h = t.h;
     yp_frame *fr = t.fr;
@@ -403,7 +370,7 @@ static void test_lod_loop_removes_overflow_and_restores_quality(void)
     CHECK(mean[5] < YP_LOD_MAX);          /* the grid still there: quality lowered */
     CHECK(mean[13] == YP_LOD_MAX);        /* the grid gone: full quality everywhere again */
     yp_lod_free(lod);
-    tanim_close(&t);
+    ypt_anim_close(&t);
 }
 
 void suite_yp_tex_lod(void)

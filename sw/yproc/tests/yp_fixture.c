@@ -1,5 +1,8 @@
 /* Scene fixtures shared by the y-processor tests (yp_fixture.h). */
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "t.h"
 #include "yp_fixture.h"
 
 void ypt_write_file(const char *path, const char *text)
@@ -32,4 +35,32 @@ void ypt_grid_anim(const char *p, int frames)
     snprintf(path, sizeof path, "build/%s_grid.anim", p);
     snprintf(text, sizeof text, "scene %s_grid.scene\nframes %d\nmove 1 5 0 0 from 6 to 9\n", p, frames);
     ypt_write_file(path, text);
+}
+
+int ypt_anim_open(ypt_anim *t, const char *path, int ext)
+{
+    memset(t, 0, sizeof *t);
+    char err[256] = "";
+    double *shade;
+    yp_options_default(&t->o);
+    if (yp_anim_load(path, &t->an, err, sizeof err) != HSR_OK) { fprintf(stderr, "%s\n", err); return 0; }
+    t->sc = yp_anim_scene(t->an);
+    t->W = t->sc->width; t->H = t->sc->height;
+    if (yp_anim_apply(t->an, 0, NULL, NULL, NULL, NULL) != HSR_OK || yp_shader_new(t->sc, YP_PHONG, &t->sh, err, sizeof err) != HSR_OK
+        || (ext && yp_anim_apply(t->an, 0, NULL, t->sh, NULL, NULL) != HSR_OK) || hsr_scene_build(t->sc, &t->h, &shade) != HSR_OK) return 0;
+    free(shade);
+    return yp_frame_new(t->W, t->H, &t->fr) == HSR_OK;
+}
+
+void ypt_anim_close(ypt_anim *t)
+{
+    yp_frame_free(t->fr); hsr_destroy(t->h); yp_shader_free(t->sh); yp_anim_free(t->an);
+}
+
+int ypt_anim_start(ypt_anim *t, const char *path, int ext)
+{
+    const int ok = ypt_anim_open(t, path, ext);
+    CHECK(ok);
+    if (!ok) ypt_anim_close(t);
+    return ok;
 }

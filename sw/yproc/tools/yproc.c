@@ -16,12 +16,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
-#include "yproc.h"
-
-int yproc_scan_main(int argc, char **argv);   /* yproc_scan.c */
-int yproc_serve_main(int argc, char **argv);  /* yproc_serve.c */
-int yproc_usage_error(const char *what, const char *arg);
-int yproc_apply_ops(hsr_ctx *h, const char *path, double **shade);   /* yproc_ops.c */
+#include "yproc_tools.h"
 
 static const char USAGE[] =
     "usage: yproc hsr SCENE [--dump-llr FILE.json] [--dump-input FILE.json] [--svg FILE.svg]\n"
@@ -68,6 +63,13 @@ static const char USAGE[] =
     "      a frame's changed lines are written to DIR/r.de48, g.de48, b.de48\n"
     "\n"
     "Errors are printed as \"file:line: message\" with exit status 1; a bad command line exits 2.\n";
+
+double yproc_clock_ms(clockid_t id)
+{
+    struct timespec t;
+    clock_gettime(id, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
 
 /* A help request anywhere on the line is answered on stdout with exit 0 (for scripts and
  * `--help` checks); a bad command line names what is wrong and exits 2. */

@@ -18,9 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "yproc.h"
-
-int yproc_apply_ops(hsr_ctx *h, const char *path, double **shade);
+#include "yproc_tools.h"
 
 typedef struct saved { hsr_domain *dom; hsr_plane pl; double op; } saved;
 

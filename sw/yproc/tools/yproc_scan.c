@@ -8,19 +8,11 @@
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
-#include "yproc.h"
-
-int yproc_scan_main(int argc, char **argv);
-int yproc_usage_error(const char *what, const char *arg);   /* yproc.c */
+#include "yproc_tools.h"
 
 /* process CPU time: the machine is shared, wall time would measure the
  * other processes too */
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
+static double now_ms(void) { return yproc_clock_ms(CLOCK_PROCESS_CPUTIME_ID); }
 
 typedef struct opts {
     const char *in, *out, *mode;

@@ -30,17 +30,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include "yproc.h"
+#include "yproc_tools.h"
 
-int yproc_serve_main(int argc, char **argv);
-int yproc_usage_error(const char *what, const char *arg);   /* yproc.c */
-
-static double wall_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
+static double wall_ms(void) { return yproc_clock_ms(CLOCK_MONOTONIC); }
 
 typedef struct server {
     hsr_scene *sc;
