@@ -399,7 +399,7 @@ module de_sdram_frames #(
   // Each FIFO's head is taken into a hold register when that is empty, so the FIFO's
   // read side depends on one flip-flop only, not on the arbiter.
   req_t [NumCh-1:0] h_q;
-  logic [NumCh-1:0] hv_q, hv_d, pad_go, want_d, want_q, grant;
+  logic [NumCh-1:0] hv_q, hv_d, pad_go, want_d, want_q, pick, grant;
   logic [NumCh-1:0][2:0] outst_q, outst_d;  // granted reads whose last word is not back
 
   for (genvar c = 0; c < NumCh; c++) begin : g_hold
@@ -430,15 +430,15 @@ module de_sdram_frames #(
   assign load     = !out_v_q;
   assign win_x = load && xv_q;
 
+  // pick: the round robin's choice among the reads (registers only: the data paths
+  // select with it); grant: pick when the register is loaded and no X goes first.
   always_comb begin
-    grant = '0;
-    if (load && !xv_q) begin
-      unique case (rr_q)
-        2'd0:    grant = want_q[1] ? 3'b010 : want_q[2] ? 3'b100 : want_q[0] ? 3'b001 : 3'b000;
-        2'd1:    grant = want_q[2] ? 3'b100 : want_q[0] ? 3'b001 : want_q[1] ? 3'b010 : 3'b000;
-        default: grant = want_q[0] ? 3'b001 : want_q[1] ? 3'b010 : want_q[2] ? 3'b100 : 3'b000;
-      endcase
-    end
+    unique case (rr_q)
+      2'd0:    pick = want_q[1] ? 3'b010 : want_q[2] ? 3'b100 : want_q[0] ? 3'b001 : 3'b000;
+      2'd1:    pick = want_q[2] ? 3'b100 : want_q[0] ? 3'b001 : want_q[1] ? 3'b010 : 3'b000;
+      default: pick = want_q[0] ? 3'b001 : want_q[1] ? 3'b010 : want_q[2] ? 3'b100 : 3'b000;
+    endcase
+    grant = (load && !xv_q) ? pick : 3'b000;
   end
 
   // Loaded whenever empty (the enable is out_v_q alone); the read's fields as an AND-OR
@@ -449,8 +449,8 @@ module de_sdram_frames #(
     sel_addr = '0;
     sel_tag  = '0;
     for (int c = 0; c < int'(NumCh); c++) begin
-      sel_addr |= {23{grant[c]}} & {2'(c), h_q[c].off};
-      sel_tag  |= {2{grant[c]}} & 2'(c);
+      sel_addr |= {23{pick[c]}} & {2'(c), h_q[c].off};
+      sel_tag  |= {2{pick[c]}} & 2'(c);
     end
   end
 
@@ -523,8 +523,9 @@ module de_sdram_frames #(
 
   // ---------------------------------------------------------------- info FIFO
   // What each granted read is, in grant order (the controller answers in order): a ring
-  // written a clock after the grant (from registers: the grant's multiplexer is not in
-  // front of the RAM's write port) and a head register, reloaded in the clock after a
+  // written a clock after the grant, from the granted colour's hold register (out_tag_q
+  // selects it; the hold is reloaded a clock later at the soonest), so the arbiter is
+  // not in front of the RAM's write port; and a head register, reloaded in the clock after a
   // burst's last word (the next burst's first word comes 2 clocks after it at the
   // soonest; a burst's first word comes 8 clocks after its grant at the soonest).
   localparam int unsigned InfoDepth = 8;
@@ -539,15 +540,16 @@ module de_sdram_frames #(
   info_t       info_mem_q [InfoDepth];
   logic [2:0]  info_wp_q, info_rp_q;
   logic [3:0]  info_cnt_q, info_cnt_d;
-  info_t       head_q, info_new, info_new_q;
+  info_t       head_q, info_new;
   logic        head_v_q, info_push, info_push_q, head_load;
   logic [1:0]  widx_q;
 
   always_comb begin
     info_new = '0;
-    for (int c = 0; c < int'(NumCh); c++) begin   // one-hot grant: an AND-OR
-      info_new |= {$bits(info_t){grant[c]}} &
-                  {h_q[c].tbl, h_q[c].vmask, h_q[c].lmask, h_q[c].win, h_q[c].comp};
+    for (int c = 0; c < int'(NumCh); c++) begin
+      if (out_tag_q == 2'(c))
+        info_new = '{tbl: h_q[c].tbl, vmask: h_q[c].vmask, lmask: h_q[c].lmask,
+                     win: h_q[c].win, comp: h_q[c].comp};
     end
   end
   assign info_push  = |grant;
@@ -559,8 +561,7 @@ module de_sdram_frames #(
   assign info_room_d = info_cnt_q <= 4'(InfoDepth - 5);
 
   always_ff @(posedge clk_sdram_i) begin
-    info_new_q <= info_new;
-    if (info_push_q) info_mem_q[info_wp_q] <= info_new_q;
+    if (info_push_q) info_mem_q[info_wp_q] <= info_new;
     if (head_load)   head_q <= info_mem_q[info_rp_q];
   end
   always_ff @(posedge clk_sdram_i) begin
