@@ -456,13 +456,17 @@ module de_sdram_ctrl #(
       f_rdb_d[b] = ge_next(s_rd_q[b], r_rd_q[b], NBl - 1);
     end
     // Next clock's e_* of the next clock's request bank: f_*_d masked by this clock's
-    // restart strobes (next clock's r_*_q).
-    c_rcd_d = f_rcd_d[cur_addr_d[AW-1 -: BankBits]] && !r_act[cur_addr_d[AW-1 -: BankBits]];
-    c_rc_d  = f_rc_d[cur_addr_d[AW-1 -: BankBits]] && !r_act[cur_addr_d[AW-1 -: BankBits]];
-    c_ras_d = f_ras_d[cur_addr_d[AW-1 -: BankBits]] && !r_act[cur_addr_d[AW-1 -: BankBits]];
-    c_rp_d  = f_rp_d[cur_addr_d[AW-1 -: BankBits]] && !r_pre[cur_addr_d[AW-1 -: BankBits]];
-    c_wr_d  = f_wr_d[cur_addr_d[AW-1 -: BankBits]] && !r_wr[cur_addr_d[AW-1 -: BankBits]];
-    c_rdb_d = f_rdb_d[cur_addr_d[AW-1 -: BankBits]] && !r_rd[cur_addr_d[AW-1 -: BankBits]];
+    // restart strobes (next clock's r_*_q). Only the request's own commands restart its
+    // bank's counters in SRun (a new request is accepted in a clock without a command,
+    // and the refresh's all-bank PRECHARGE comes with no request; the next request's
+    // flags are computed afresh when it is accepted), so the mask is the command itself,
+    // not the per-bank strobe selected by the bank: one level less behind the decision.
+    c_rcd_d = f_rcd_d[cur_addr_d[AW-1 -: BankBits]] && !do_act;
+    c_rc_d  = f_rc_d[cur_addr_d[AW-1 -: BankBits]] && !do_act;
+    c_ras_d = f_ras_d[cur_addr_d[AW-1 -: BankBits]] && !do_act;
+    c_rp_d  = f_rp_d[cur_addr_d[AW-1 -: BankBits]] && !do_pre;
+    c_wr_d  = f_wr_d[cur_addr_d[AW-1 -: BankBits]] && !(do_wr || do_wr2);
+    c_rdb_d = f_rdb_d[cur_addr_d[AW-1 -: BankBits]] && !do_rd;
   end
 
   // ---------------------------------------------------------------- read data

@@ -7,11 +7,12 @@
 // two flip-flops (ASYNC_REG), so a pointer in flight is either its old or its new value
 // and full / empty are conservative, never wrong.
 //
-// Write side: wready_o = not full; wfree_o = free entries, registered and conservative:
-// it counts every push up to this clock as if one more came in this clock, and pops only
-// once they have crossed (it does not wait for this clock's push, so the push decision
-// and the pointer arithmetic are in different clocks); de_sdram_frames uses it to see
-// its X FIFO drained (its prefetch FIFOs' credit is kept on the read side's clock).
+// Write side: wready_o = not full (a register, conservative for a clock); wfree_o = free
+// entries, registered and conservative: it counts every push up to this clock as if one
+// more came in this clock, and pops only once they have crossed (it does not wait for
+// this clock's push, so the push decision and the pointer arithmetic are in different
+// clocks); de_sdram_frames uses it to see its X FIFO drained (its prefetch FIFOs' credit
+// is kept on the read side's clock).
 // Read side: show-ahead (rvalid_o / rdata_o / rready_o). The memory is read only when
 // the synchronised write pointer says the entry is written, at least one read clock after
 // the synchroniser saw it, into the output register, so the two ports never touch the
@@ -56,7 +57,7 @@ module de_async_fifo #(
   // Write side.
   ptr_t wbin_d, wbin_q, wgray_q, rdec_q, rbin_w_q, wfree_d, wfree_q, used;
   (* ASYNC_REG = "TRUE" *) ptr_t rgray_w1_q, rgray_w2_q;
-  logic push;
+  logic push, full_d, full_q;
   // Read side.
   ptr_t rbin_d, rbin_q, rgray_q;
   (* ASYNC_REG = "TRUE" *) ptr_t wgray_r1_q, wgray_r2_q;
@@ -71,9 +72,13 @@ module de_async_fifo #(
   // an XOR of at most half the pointer plus one, two LUT levels; decoded in one step, the
   // bits share a chain (b[i] = b[i+1] ^ g[i]) that synthesis keeps 9-11 LUTs deep at
   // Depth 2048, the worst path of the 125 MHz write side.
+  // Full is a register (so the push is one gate after flip-flops): what this clock's
+  // count and push make it, against the read pointer as it is now (it can only move on:
+  // conservative for one clock).
   assign used     = wbin_q - rbin_w_q;                 // 0 .. Depth
-  assign wready_o = !used[AW];
-  assign push     = wvalid_i && wready_o;
+  assign wready_o = !full_q;
+  assign push     = wvalid_i && !full_q;
+  assign full_d   = push ? (used == ptr_t'(Depth - 1)) : used[AW];
   assign wbin_d   = push ? wbin_q + 1'b1 : wbin_q;
   // Depth - 1 - used (a push this clock counted whether or not it comes), 0 when full.
   assign wfree_d  = used[AW] ? '0 : {1'b0, ~used[AW-1:0]};
@@ -90,6 +95,7 @@ module de_async_fifo #(
       rgray_w2_q <= '0;
       rdec_q     <= '0;
       rbin_w_q   <= '0;
+      full_q     <= 1'b0;
       wfree_q    <= ptr_t'(Depth);
     end else begin
       wbin_q     <= wbin_d;
@@ -100,6 +106,7 @@ module de_async_fifo #(
         rdec_q[i]   <= (i >= int'(HB)) ? ^(rgray_w2_q >> i) : rgray_w2_q[i];
         rbin_w_q[i] <= (i >= int'(HB)) ? rdec_q[i] : rdec_q[HB] ^ (^(rdec_q[HB-1:0] >> i));
       end
+      full_q     <= full_d;
       wfree_q    <= wfree_d;
     end
   end
