@@ -26,8 +26,12 @@ module de_pe
   input  logic             bypass_i = 1'b0,
   input  logic [IdW-1:0]   id_i,         // identifier of the slot at stage 0
   input  logic [DataW-1:0] data_i,       // skewed: [j*12 +: 12] = block j of stage j's slot
+  // Timing only: data_i's block 1 is zero, registered by the sender beside its data_o
+  // (the previous PE's blk1z_o, or a register in front of PE 0). Not architectural.
+  input  logic             blk1z_i,
   output logic [IdW-1:0]   id_o,         // registered, to the next PE
   output logic [DataW-1:0] data_o,       // registered, to the next PE (same skew)
+  output logic             blk1z_o,      // registered: data_o's block 1 is zero
   output logic             pix_valid_o,  // registered: a Refresh's pixel this cycle
   output logic [PixW-1:0]  pix_o,        // registered: D[35:24], zero when not valid
   output logic [DbgW-1:0]  dbg_o         // all state, for the testbench (unused in a chip)
@@ -40,6 +44,22 @@ module de_pe
   if (!id_layout_ok()) begin : g_bad_id_layout
     $fatal(1, "de_pkg: id_t does not match the Id*Bit positions");
   end
+  if (AddCarryBlk == 1) begin : g_bad_carry_blk
+    // blk1z_d's zero test of a block-1 sum takes the carry into bit 0 (sum_is_zero).
+    $fatal(1, "de_pe: the carry fault must not enter block 1 (AddCarryBlk = 1)");
+  end
+
+  // a + b + cin == 0 (mod 2^BlkW) is the AND of these bits, without the carry chain: sum
+  // bit i is 0 exactly when the carry into bit i equals a[i] ^ b[i], and the carry out of
+  // bit i is then a[i] | b[i]; so every bit is a function of four inputs (one LUT4), side
+  // by side with the adder instead of behind it.
+  function automatic logic [BlkW-1:0] zero_terms(input logic [BlkW-1:0] a,
+                                                 input logic [BlkW-1:0] b, input logic cin);
+    zero_terms[0] = ((a[0] ^ b[0]) == cin);
+    for (int i = 1; i < BlkW; i++) begin
+      zero_terms[i] = ((a[i] ^ b[i]) == (a[i-1] | b[i-1]));
+    end
+  endfunction
 
   // ---- registers (every one is a _d/_q pair) -------------------------------------------
   // Architectural: A, B, C, D as three 12-bit blocks, the flags.
@@ -74,6 +94,8 @@ module de_pe
   logic [BlkW-1:0] src1_d, src1_q, dst1_d, dst1_q, src2_d, src2_q, dst2_d, dst2_q;
   // Timing only, likewise: the register write of the slot in stage 1 / 2 (wr1, wr2).
   logic wr1_d, wr1_q, wr2_d, wr2_q;
+  // Timing only, likewise: out_q's block 1 is zero (the next PE's zero test of block 1).
+  logic blk1z_d, blk1z_q;
 
   // ---- inputs and decode -------------------------------------------------------------
   logic [NumBlk-1:0][BlkW-1:0] in_blk;
@@ -96,12 +118,9 @@ module de_pe
   // An address slot fires when, periodic, its countdown (block 1) is 0, or, range, X was
   // 0 (xz1_q) and dX (block 1) is not: fire1 = id1.addr && (per1 ? z1 : xz1_q && !z1).
   logic z1, per1, act_eff;
-  // The zero test in two kept halves of 6 bits, so that act_eff is one LUT4 of both halves
-  // and aez_q/aenz_q rather than one more level behind a 12-bit test.
-  (* keep *) logic z1_lo, z1_hi;
-  assign z1_lo     = (in_blk[1][BlkW/2-1:0] == '0);
-  assign z1_hi     = (in_blk[1][BlkW-1:BlkW/2] == '0);
-  assign z1        = z1_lo && z1_hi;
+  // The zero test of block 1 is made by the sender, from its own candidates for the
+  // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below).
+  assign z1        = blk1z_i;
   assign per1      = id1.addr && (id1.sub == SubPeriodic);
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
   // sees that slot's decision at once; later slots of the command see the act register:
@@ -158,7 +177,8 @@ module de_pe
   logic [BlkW:0] sp1, sn1, s1;
   assign ev1     = id1.data && !id1.set;
   assign active1 = ev1 && act1_q;
-  // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the adder.
+  // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the
+  // adder. All ones when the slot does not add (sum1 = 0), for blk1z_d's test of in - 1.
   assign src1    = src1_q;
   // As in stage 0: both operand sums, prot1_q picks one after the adders.
   assign sp1     = {1'b0, dst1_q} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
@@ -187,6 +207,28 @@ module de_pe
   assign q1    = (per1 && live) ? out_q[0] - BlkW'(1) : '0;
   assign pass1 = z1 ? q1 : d1;
   assign out1  = sum1 ? s1[BlkW-1:0] : pass1;
+
+  // out1 == 0 for the next PE, from the same candidates rather than behind the out1 mux,
+  // so that the input block is three LUT levels from blk1z_q: the sums by zero_terms (no
+  // carry chain) in groups of four bits, kept; q1 = 0 unless a periodic reload of P = 1;
+  // d1 = in - dec1 = 0 only as 1 - 1, which is the same test of in + src1 with src1 all
+  // ones (src1_q is, when the slot does not add; c1_q is 0 then).
+  // Every level is a kept net: left to itself, synthesis takes bit 0 from the adder's
+  // CCU2C and merges the levels into wider, deeper functions.
+  (* keep *) logic [BlkW-1:0] tn1, tp1;
+  (* keep *) logic [2:0] zn_g, zp_g;
+  (* keep *) logic zrest, seln1;
+  logic zq1;
+  assign tn1   = zero_terms(in_blk[1], src1, c1_q);
+  assign tp1   = zero_terms(dst1_q, src1, c1_q);
+  for (genvar g = 0; g < 3; g++) begin : g_zero_grp
+    assign zn_g[g] = &tn1[g*BlkW/3 +: BlkW/3];
+    assign zp_g[g] = &tp1[g*BlkW/3 +: BlkW/3];
+  end
+  assign zq1     = !(per1 && live) || (out_q[0] == BlkW'(1));
+  assign seln1   = sum1 ? !prot1_q : (!z1 && dec1);
+  assign zrest   = (sum1 && prot1_q) ? &zp_g : (!sum1 && z1 && zq1);
+  assign blk1z_d = seln1 ? &zn_g : zrest;
 
   // ---- stage 2: block 2 ------------------------------------------------------------------
   logic ev2, active2, wr2;
@@ -362,7 +404,7 @@ module de_pe
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
   assign wr1_d  = wr0;
   assign wr2_d  = wr1;
-  assign src1_d = reg_blk(id0.src, a_d[1], b_d[1], c_d[1]);
+  assign src1_d = sum0 ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
@@ -398,11 +440,13 @@ module de_pe
   // flip-flop with no OR or mux behind it (docs/fpga.md, section 6.3).
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
-      id_q  <= '0;
-      out_q <= '0;
+      id_q    <= '0;
+      out_q   <= '0;
+      blk1z_q <= 1'b1;  // out_q is zero
     end else begin
-      id_q  <= id_d;
-      out_q <= out_d;
+      id_q    <= id_d;
+      out_q   <= out_d;
+      blk1z_q <= blk1z_d;
     end
   end
 
@@ -488,6 +532,7 @@ module de_pe
   // ---- outputs ----------------------------------------------------------------------------
   assign id_o        = id_q;
   assign data_o      = out_q;
+  assign blk1z_o     = blk1z_q;
   assign pix_valid_o = pixv_q;
   assign pix_o       = pix_q;
 
