@@ -112,6 +112,9 @@ module de_chip_core
   logic [NumPe-1:0]           src_pixv;
   logic [NumPe-1:0]          coll;
   logic [NumPe-1:0]          byp_d, byp_q;
+  // !byp_q, a register of its own for each PE's pass-through terms (de_pe live_i): kept,
+  // so that they do not share the fan-out of byp_q, which resets the whole PE.
+  (* keep *) logic [NumPe-1:0] live_q;
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
   assign bus_id[0]   = link_i.id;
@@ -137,6 +140,7 @@ module de_chip_core
       .clk_i,
       .rst_i,
       .bypass_i   (byp_q[i]),
+      .live_i     (live_q[i]),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .blk1z_i    (bus_blk1z[i]),
@@ -249,10 +253,12 @@ module de_chip_core
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
       byp_q   <= '0;
+      live_q  <= '1;
       reach_q <= '1;   // no PE bypassed
       obs_q   <= '0;
     end else begin
       byp_q   <= byp_d;
+      live_q  <= ~byp_d;
       reach_q <= reach_d;
       obs_q   <= obs_d;
     end

@@ -24,6 +24,9 @@ module de_pe
   // Static (a chip's configuration): the PE is replaced by a register. id_o/data_o carry
   // id_i/data_i one clock later and every other register is held in reset.
   input  logic             bypass_i = 1'b0,
+  // = !bypass_i, from a register of its own (timing only): the pass-through terms then do
+  // not wait on bypass_i's fan-out, the reset of every other register.
+  input  logic             live_i = 1'b1,
   input  logic [IdW-1:0]   id_i,         // identifier of the slot at stage 0
   input  logic [DataW-1:0] data_i,       // skewed: [j*12 +: 12] = block j of stage j's slot
   // Timing only: data_i's block 1 is zero, registered by the sender beside its data_o
@@ -154,7 +157,7 @@ module de_pe
   // In bypass, every block passes unchanged (live = 0); the rest of the PE is in reset,
   // but not yet in the first cycle of the bypass, hence the explicit term.
   logic live;
-  assign live = !bypass_i;
+  assign live = live_i;
 
   // out0 = sum0 ? s0 : pass0. The select and the pass value are kept as nets of their
   // own, so that the last LUT in front of out_q[0] has the five inputs sum0, pv0, sp0,
