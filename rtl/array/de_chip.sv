@@ -115,6 +115,9 @@ module de_chip_core
   // !byp_q, a register of its own for each PE's pass-through terms (de_pe live_i): kept,
   // so that they do not share the fan-out of byp_q, which resets the whole PE.
   (* keep *) logic [NumPe-1:0] live_q;
+  // byp_q again, for the PE's own reset only (de_pe bypass_i): kept for the same reason,
+  // so that it can sit in the PE rather than in the configuration shift register.
+  (* keep *) logic [NumPe-1:0] byp_pe_q;
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
   assign bus_id[0]   = link_i.id;
@@ -139,7 +142,7 @@ module de_chip_core
     de_pe #(.CarryBug(CarryBug)) u_pe (
       .clk_i,
       .rst_i,
-      .bypass_i   (byp_q[i]),
+      .bypass_i   (byp_pe_q[i]),
       .live_i     (live_q[i]),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
@@ -254,11 +257,13 @@ module de_chip_core
     if (rst_i) begin
       byp_q   <= '0;
       live_q  <= '1;
+      byp_pe_q <= '0;
       reach_q <= '1;   // no PE bypassed
       obs_q   <= '0;
     end else begin
       byp_q   <= byp_d;
       live_q  <= ~byp_d;
+      byp_pe_q <= byp_d;
       reach_q <= reach_d;
       obs_q   <= obs_d;
     end

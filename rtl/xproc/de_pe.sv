@@ -99,6 +99,8 @@ module de_pe
   logic wr1_d, wr1_q, wr2_d, wr2_q;
   // Timing only, likewise: out_q's block 1 is zero (the next PE's zero test of block 1).
   logic blk1z_d, blk1z_q;
+  // Timing only, likewise: the stage-1 slot is a periodic address (per1, from id_q).
+  logic per1_d, per1_q;
 
   // ---- inputs and decode -------------------------------------------------------------
   logic [NumBlk-1:0][BlkW-1:0] in_blk;
@@ -124,7 +126,8 @@ module de_pe
   // The zero test of block 1 is made by the sender, from its own candidates for the
   // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below).
   assign z1        = blk1z_i;
-  assign per1      = id1.addr && (id1.sub == SubPeriodic);
+  // = id1.addr && (id1.sub == SubPeriodic), registered beside id_q (per1_q).
+  assign per1      = per1_q;
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
   // sees that slot's decision at once; later slots of the command see the act register:
   // act_eff = id1.addr ? fire1 : act_q. Everything in it but the zero test of block 1 is
@@ -139,7 +142,11 @@ module de_pe
   assign ev0     = id0.data && !id0.set;
   assign st0     = id0.data && id0.set;
   assign rng0    = id0.addr && (id0.sub != SubPeriodic);
-  assign xz0     = (in_blk[0] == '0);
+  // X - 1 as a constant decrement with its carry out: the carry is 1 unless X is 0, so the
+  // zero test of X comes out of the same carry chain, not from two LUT levels of its own.
+  (* keep *) logic [BlkW:0] dm0;
+  assign dm0     = {1'b0, in_blk[0]} + {1'b0, {BlkW{1'b1}}};
+  assign xz0     = !dm0[BlkW];
   // Protection is decided once per slot, here, and travels with it down the pipeline;
   // pv0 is the part that does not depend on act_eff.
   assign pv0     = ev0 && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
@@ -162,16 +169,13 @@ module de_pe
   // out0 = sum0 ? s0 : pass0. The select and the pass value are kept as nets of their
   // own, so that the last LUT in front of out_q[0] has the five inputs sum0, pv0, sp0,
   // sn0, pass0 (one PFUMX) rather than a 7-input function of the decisions.
-  (* keep *) logic sum0;
+  // Relative addressing counts X down to 0 and keeps it there: pass0 picks X, X - 1 or 0
+  // after the decrement (a LUT4 of rng0l, the carry, the two bits).
+  (* keep *) logic sum0, rng0l;
   (* keep *) logic [BlkW-1:0] pass0;
-  assign sum0 = active0 && live;
-  always_comb begin
-    pass0 = in_blk[0];
-    if (rng0 && live) begin
-      // Relative addressing: count X down to 0 and keep it there.
-      pass0 = xz0 ? '0 : in_blk[0] - BlkW'(1);
-    end
-  end
+  assign sum0  = active0 && live;
+  assign rng0l = rng0 && live;
+  assign pass0 = rng0l ? (xz0 ? '0 : dm0[BlkW-1:0]) : in_blk[0];
   assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
 
   // ---- stage 1: block 1 ------------------------------------------------------------------
@@ -181,7 +185,7 @@ module de_pe
   assign ev1     = id1.data && !id1.set;
   assign active1 = ev1 && act1_q;
   // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the
-  // adder. All ones when the slot does not add (sum1 = 0), for blk1z_d's test of in - 1.
+  // adder. All ones for an address slot (it never adds), for blk1z_d's test of in - 1.
   assign src1    = src1_q;
   // As in stage 0: both operand sums, prot1_q picks one after the adders.
   assign sp1     = {1'b0, dst1_q} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
@@ -199,14 +203,16 @@ module de_pe
   // An address slot decrements block 1 (the countdown, or dX when X was 0) unless it is
   // 0; then a periodic slot reloads P-1 from out_q block 0, which still holds the period
   // this slot passed on unchanged one cycle ago (no extra register), and any other slot
-  // passes the 0. The decrement subtracts dec1 (not a mux after it): one carry chain.
-  (* keep *) logic sum1;
-  (* keep *) logic [BlkW-1:0] pass1;
-  logic dec1;
+  // passes the 0. The decrement is a constant one (dm1, kept) and dec1 picks it after the
+  // carry chain, so the chain starts at the input block and not behind the decision;
+  // dec1 = live && (per1 || (id1.addr && xz1_q)), where xz1_q implies id1.addr.
+  (* keep *) logic sum1, dec1;
+  (* keep *) logic [BlkW-1:0] pass1, dm1;
   logic [BlkW-1:0] q1, d1;
   assign sum1  = active1 && live;
-  assign dec1  = live && (per1 || (id1.addr && xz1_q));
-  assign d1    = in_blk[1] - BlkW'(dec1);
+  assign dec1  = live && (per1 || xz1_q);
+  assign dm1   = in_blk[1] - BlkW'(1);
+  assign d1    = dec1 ? dm1 : in_blk[1];
   assign q1    = (per1 && live) ? out_q[0] - BlkW'(1) : '0;
   assign pass1 = z1 ? q1 : d1;
   assign out1  = sum1 ? s1[BlkW-1:0] : pass1;
@@ -215,7 +221,7 @@ module de_pe
   // so that the input block is three LUT levels from blk1z_q: the sums by zero_terms (no
   // carry chain) in groups of four bits, kept; q1 = 0 unless a periodic reload of P = 1;
   // d1 = in - dec1 = 0 only as 1 - 1, which is the same test of in + src1 with src1 all
-  // ones (src1_q is, when the slot does not add; c1_q is 0 then).
+  // ones (src1_q is, for the address slots that decrement; c1_q is 0 then).
   // Every level is a kept net: left to itself, synthesis takes bit 0 from the adder's
   // CCU2C and merges the levels into wider, deeper functions.
   (* keep *) logic [BlkW-1:0] tn1, tp1;
@@ -407,7 +413,7 @@ module de_pe
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
   assign wr1_d  = wr0;
   assign wr2_d  = wr1;
-  assign src1_d = sum0 ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
+  assign src1_d = id0.addr ? '1 : reg_blk(id0.src, a_d[1], b_d[1], c_d[1]);
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
@@ -417,6 +423,7 @@ module de_pe
   assign out_d    = {out2, out1, out0};
   assign id2_d    = id_q;
   assign xz1_d    = rng0 && xz0;
+  assign per1_d   = id0.addr && (id0.sub == SubPeriodic);
   assign act1_d   = act_eff;
   assign prot1_d  = prot0;
   assign c1_d     = sum0 && s0[BlkW];     // = active0 && s0[BlkW] (in bypass c1_q is held in reset)
@@ -440,16 +447,23 @@ module de_pe
   // exactly as the structural model treats it.
   // The bus registers: the PE's own output, or in bypass its input one clock later. The
   // bypass register of a chip is thus this register, and the next PE's input is a
-  // flip-flop with no OR or mux behind it (docs/fpga.md, section 6.3).
+  // flip-flop with no OR or mux behind it (docs/fpga.md, section 6.3). Beside them the
+  // timing-only registers that follow id_q and out_q through a bypass, so that they are
+  // right in the first cycle after one: per1_q (of id_q), blk1z_q (of out_q), src1_q
+  // (all ones for an address slot; a data slot finds act1_q reset and does not add).
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
       id_q    <= '0;
       out_q   <= '0;
       blk1z_q <= 1'b1;  // out_q is zero
+      per1_q  <= 1'b0;
+      src1_q  <= '0;
     end else begin
       id_q    <= id_d;
       out_q   <= out_d;
       blk1z_q <= blk1z_d;
+      per1_q  <= per1_d;
+      src1_q  <= src1_d;
     end
   end
 
@@ -486,7 +500,6 @@ module de_pe
       aenz_q   <= 1'b0;
       disx_q   <= 1'b0;
       e0x_q    <= 1'b0;
-      src1_q   <= '0;
       wr1_q    <= 1'b0;
       wr2_q    <= 1'b0;
       dst1_q   <= '0;
@@ -523,7 +536,6 @@ module de_pe
       aenz_q   <= aenz_d;
       disx_q   <= disx_d;
       e0x_q    <= e0x_d;
-      src1_q   <= src1_d;
       wr1_q    <= wr1_d;
       wr2_q    <= wr2_d;
       dst1_q   <= dst1_d;
