@@ -253,28 +253,6 @@ module de_chip_core
   end
   assign chain_o.obs = obs_q[0];
 
-  // Configuration and observation registers.
-  always_ff @(posedge clk_i) begin
-    if (rst_i) begin
-      byp_q   <= '0;
-      live_q  <= '1;
-      byp_pe_q <= '0;
-      collm_q <= '0;
-      for (int i = 0; i < NumPe; i++) begin
-        for (int s = 0; s <= i; s++) collm_q[i][s] <= 1'b1;  // no PE bypassed
-      end
-      reach_q <= '1;   // no PE bypassed
-      obs_q   <= '0;
-    end else begin
-      byp_q   <= byp_d;
-      live_q  <= ~byp_d;
-      byp_pe_q <= byp_d;
-      collm_q <= collm_d;
-      reach_q <= reach_d;
-      obs_q   <= obs_d;
-    end
-  end
-
   // Two pixels meet at PE i when one reaches position i (pixv_or[i]) while PE i, in use,
   // shows its own. Not built behind pixv_or (the OR tree, then this AND, then the OR over
   // the PEs) but as one OR of three-input terms, each gated by a registered bit:
@@ -296,6 +274,28 @@ module de_chip_core
       for (int s = 1; s <= i; s++) begin
         coll = coll | (collm_q[i][s] && src_pixv[s-1] && pe_pixv_v[i]);
       end
+    end
+  end
+
+  // Configuration and observation registers.
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      byp_q   <= '0;
+      live_q  <= '1;
+      byp_pe_q <= '0;
+      collm_q <= '0;
+      for (int i = 0; i < NumPe; i++) begin
+        for (int s = 0; s <= i; s++) collm_q[i][s] <= 1'b1;  // no PE bypassed
+      end
+      reach_q <= '1;   // no PE bypassed
+      obs_q   <= '0;
+    end else begin
+      byp_q   <= byp_d;
+      live_q  <= ~byp_d;
+      byp_pe_q <= byp_d;
+      collm_q <= collm_d;
+      reach_q <= reach_d;
+      obs_q   <= obs_d;
     end
   end
 
