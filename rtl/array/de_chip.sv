@@ -110,8 +110,7 @@ module de_chip_core
   logic [NumPe:0]            pixv_or;
   logic [NumPe-1:0][PixW-1:0] src_pix;  // what PE i puts on the pixel chain
   logic [NumPe-1:0]           src_pixv;
-  logic [NumPe-1:0]          pe_pixv_v;
-  logic                      coll;
+  logic [NumPe-1:0]          coll;
   logic [NumPe-1:0]          byp_d, byp_q;
   // !byp_q, a register of its own for each PE's pass-through terms (de_pe live_i): kept,
   // so that they do not share the fan-out of byp_q, which resets the whole PE.
@@ -185,7 +184,7 @@ module de_chip_core
     // pixel in a cycle, so OR is a mux.
     assign src_pix[i]  = byp_q[i] ? byp_pix_q  : (pe_pixv ? pe_pix : '0);
     assign src_pixv[i] = byp_q[i] ? byp_pixv_q : pe_pixv;
-    assign pe_pixv_v[i] = pe_pixv;
+    assign coll[i]     = pixv_or[i] && pe_pixv && !byp_q[i];
     // A bypassed PE's stage-1 identifier register carries the passing slots; the
     // observation word shows zero there, as it did when the PE's id_q was in reset: from
     // the clock after the bypass bit is set to the clock after it is cleared (byp_id0_q).
@@ -253,53 +252,24 @@ module de_chip_core
   end
   assign chain_o.obs = obs_q[0];
 
-  // Two pixels meet at PE i when one reaches position i (pixv_or[i]) while PE i, in use,
-  // shows its own. Not built behind pixv_or (the OR tree, then this AND, then the OR over
-  // the PEs) but as one OR of three-input terms, each gated by a registered bit:
-  // collm_q[i][s] = source s reaches position i and PE i is in use.
-  logic [NumPe-1:0][NumPe:0] collm_d, collm_q;
-  always_comb begin
-    collm_d = '0;
-    collm_d[0][0] = !byp_d[0];
-    for (int i = 1; i < NumPe; i++) begin
-      for (int s = 0; s <= i; s++) begin
-        collm_d[i][s] = reach_d[i][s] && !byp_d[i];
-      end
-    end
-  end
-  always_comb begin
-    coll = 1'b0;
-    for (int i = 0; i < NumPe; i++) begin
-      coll = coll | (collm_q[i][0] && pixv_or[0] && pe_pixv_v[i]);
-      for (int s = 1; s <= i; s++) begin
-        coll = coll | (collm_q[i][s] && src_pixv[s-1] && pe_pixv_v[i]);
-      end
-    end
-  end
-
   // Configuration and observation registers.
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
       byp_q   <= '0;
       live_q  <= '1;
       byp_pe_q <= '0;
-      collm_q <= '0;
-      for (int i = 0; i < NumPe; i++) begin
-        for (int s = 0; s <= i; s++) collm_q[i][s] <= 1'b1;  // no PE bypassed
-      end
       reach_q <= '1;   // no PE bypassed
       obs_q   <= '0;
     end else begin
       byp_q   <= byp_d;
       live_q  <= ~byp_d;
       byp_pe_q <= byp_d;
-      collm_q <= collm_d;
       reach_q <= reach_d;
       obs_q   <= obs_d;
     end
   end
 
-  assign link_o = {bus_id[NumPe], bus_data[NumPe], pixv_or[NumPe], pix_or[NumPe], coll};
+  assign link_o = {bus_id[NumPe], bus_data[NumPe], pixv_or[NumPe], pix_or[NumPe], |coll};
 
 endmodule
 

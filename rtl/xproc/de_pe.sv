@@ -47,6 +47,22 @@ module de_pe
   if (!id_layout_ok()) begin : g_bad_id_layout
     $fatal(1, "de_pkg: id_t does not match the Id*Bit positions");
   end
+  if (AddCarryBlk == 1) begin : g_bad_carry_blk
+    // blk1z_d's zero test of a block-1 sum takes the carry into bit 0 (zero_terms).
+    $fatal(1, "de_pe: the carry fault must not enter block 1 (AddCarryBlk = 1)");
+  end
+
+  // a + b + cin == 0 (mod 2^BlkW) is the AND of these bits, without the carry chain: sum
+  // bit i is 0 exactly when the carry into bit i equals a[i] ^ b[i], and the carry out of
+  // bit i is then a[i] | b[i]; so every bit is a function of four inputs (one LUT4), side
+  // by side with the adder instead of behind it.
+  function automatic logic [BlkW-1:0] zero_terms(input logic [BlkW-1:0] a,
+                                                 input logic [BlkW-1:0] b, input logic cin);
+    zero_terms[0] = ((a[0] ^ b[0]) == cin);
+    for (int i = 1; i < BlkW; i++) begin
+      zero_terms[i] = ((a[i] ^ b[i]) == (a[i-1] | b[i-1]));
+    end
+  endfunction
 
   // ---- registers (every one is a _d/_q pair) -------------------------------------------
   // Architectural: A, B, C, D as three 12-bit blocks, the flags.
@@ -168,7 +184,8 @@ module de_pe
   logic [BlkW:0] sp1, sn1, s1;
   assign ev1     = id1.data && !id1.set;
   assign active1 = ev1 && act1_q;
-  // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the adder.
+  // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the
+  // adder. All ones when the slot does not add (sum1 = 0), for blk1z_d's test of in - 1.
   assign src1    = src1_q;
   // As in stage 0: both operand sums, prot1_q picks one after the adders.
   assign sp1     = {1'b0, dst1_q} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
@@ -202,21 +219,28 @@ module de_pe
   assign pass1 = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
   assign out1  = sum1 ? s1[BlkW-1:0] : pass1;
 
-  // out1 == 0 for the next PE (blk1z_d). Only an address slot's zero test of block 1 is
-  // ever used (act_eff, the Dis/Eval0 fire and pass1 act on address slots only), and an
-  // address slot never adds (sum1 needs a data slot): so the flag is that of pass1, taken
-  // from its candidates rather than behind its mux: q1 = P - 1 = 0 when P = 1, d1 = 0 only
-  // as 1 - 1 (z1 already says whether block 1 is 0). For any other slot the flag is not
-  // defined (it carries z1 on) and nothing reads it.
-  (* keep *) logic [2:0] one1_g;  // in_blk[1] == 1, in three groups of four bits
-  (* keep *) logic zq1z;
+  // out1 == 0 for the next PE (blk1z_d), from the candidates rather than behind the out1
+  // mux, so that the input block is three LUT levels from blk1z_q: the sums by zero_terms
+  // (no carry chain) in kept groups of four bits; q1 = P - 1 = 0 when P = 1; d1 = in - 1 =
+  // 0 only when in is 1, which is the same test of in + src1 with src1 all ones (src1_q
+  // is, when the slot does not add; c1_q is 0 then). Only address slots read the flag
+  // (they never add, but an identifier with both class bits would), so each level is
+  // kept: left to itself, synthesis takes bit 0 from the adder's CCU2C and merges the
+  // levels into wider, deeper functions.
+  (* keep *) logic [BlkW-1:0] tn1, tp1;
+  (* keep *) logic [2:0] zn_g, zp_g;
+  (* keep *) logic zrest, seln1;
   logic zq1;
-  assign one1_g[0] = (in_blk[1][3:0] == 4'd1);
-  assign one1_g[1] = (in_blk[1][7:4] == '0);
-  assign one1_g[2] = (in_blk[1][BlkW-1:8] == '0);
-  assign zq1       = !(per1 && live) || (out_q[0] == BlkW'(1));
-  assign zq1z      = z1 && zq1;
-  assign blk1z_d   = seld1 ? &one1_g : zq1z;
+  assign tn1     = zero_terms(in_blk[1], src1, c1_q);
+  assign tp1     = zero_terms(dst1_q, src1, c1_q);
+  for (genvar g = 0; g < 3; g++) begin : g_zero_grp
+    assign zn_g[g] = &tn1[g*BlkW/3 +: BlkW/3];
+    assign zp_g[g] = &tp1[g*BlkW/3 +: BlkW/3];
+  end
+  assign zq1     = !(per1 && live) || (out_q[0] == BlkW'(1));
+  assign seln1   = sum1 ? !prot1_q : seld1;
+  assign zrest   = sum1 ? (prot1_q && &zp_g) : (z1 && zq1);
+  assign blk1z_d = seln1 ? &zn_g : zrest;
 
   // ---- stage 2: block 2 ------------------------------------------------------------------
   logic ev2, active2, wr2;
@@ -392,7 +416,7 @@ module de_pe
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
   assign wr1_d  = wr0;
   assign wr2_d  = wr1;
-  assign src1_d = reg_blk(id0.src, a_d[1], b_d[1], c_d[1]);
+  assign src1_d = sum0 ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
@@ -428,18 +452,22 @@ module de_pe
   // bypass register of a chip is thus this register, and the next PE's input is a
   // flip-flop with no OR or mux behind it (docs/fpga.md, section 6.3). Beside them the
   // timing-only registers that follow id_q and out_q through a bypass, so that they are
-  // right in the first cycle after one: per1_q (of id_q), blk1z_q (of out_q).
+  // right in the first cycle after one: per1_q (of id_q), blk1z_q (of out_q), src1_q
+  // (all ones through a bypass, where nothing adds, as in the cycle after it, where
+  // act1_q is still reset).
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
       id_q    <= '0;
       out_q   <= '0;
       blk1z_q <= 1'b1;  // out_q is zero
       per1_q  <= 1'b0;
+      src1_q  <= '0;
     end else begin
       id_q    <= id_d;
       out_q   <= out_d;
       blk1z_q <= blk1z_d;
       per1_q  <= per1_d;
+      src1_q  <= src1_d;
     end
   end
 
@@ -476,7 +504,6 @@ module de_pe
       aenz_q   <= 1'b0;
       disx_q   <= 1'b0;
       e0x_q    <= 1'b0;
-      src1_q   <= '0;
       wr1_q    <= 1'b0;
       wr2_q    <= 1'b0;
       dst1_q   <= '0;
@@ -513,7 +540,6 @@ module de_pe
       aenz_q   <= aenz_d;
       disx_q   <= disx_d;
       e0x_q    <= e0x_d;
-      src1_q   <= src1_d;
       wr1_q    <= wr1_d;
       wr2_q    <= wr2_d;
       dst1_q   <= dst1_d;
