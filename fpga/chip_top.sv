@@ -16,7 +16,8 @@
 
 module chip_top #(
   parameter int unsigned NumPe    = 9,
-  parameter int unsigned CarryBug = 0
+  parameter int unsigned CarryBug = 0,
+  parameter int unsigned Compact  = 0    // de_pe Compact (1: the iCE40 chip, which is full)
 ) (
   input  logic clk_i,
   input  logic rst_i,
@@ -58,7 +59,7 @@ module chip_top #(
     blk1z_q     <= (sh_q[34:23] == '0);
   end
 
-  de_chip #(.NumPe(NumPe), .CarryBug(CarryBug)) u_chip (
+  de_chip #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact)) u_chip (
     .clk_i,
     .rst_i      (rst_q),
     // id, data, pix_valid, pix from the shift register; de_chip does not use link_i.coll

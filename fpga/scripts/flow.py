@@ -193,6 +193,9 @@ def nobypass_chip(out: Path) -> Path:
 
 
 # ---------------------------------------------------------------------------- chip
+COMPACT = {"ecp5": 0, "ice40": 1}   # de_pe Compact per family (chip only)
+
+
 def chip(args) -> int:
     fam = args.family
     tmpl = f"chip_{fam}.ys"
@@ -206,11 +209,14 @@ def chip(args) -> int:
         swap = {"rtl/array/de_chip.sv": str(nobypass_chip(out))} if nobyp else {}
         srcs_top = [swap.get(s, s) for s in core_srcs("fpga", "chip")]
         srcs = [swap.get(s, s) for s in core_srcs("chip")]
-        cells_top = yosys(tmpl, out, "chip_top", srcs_top, {"NumPe": npe})
+        # The iCE40 HX8K is full with 9 PEs: there the PE takes the small form of its
+        # timing-only logic (de_pe Compact, same cycle behaviour; docs/fpga.md 6.3).
+        params = {"NumPe": npe, "Compact": COMPACT[fam]}
+        cells_top = yosys(tmpl, out, "chip_top", srcs_top, params)
         bare = out / "bare"
-        cells_chip = yosys(tmpl, bare, "de_chip", srcs, {"NumPe": npe})
+        cells_chip = yosys(tmpl, bare, "de_chip", srcs, params)
         r = {"num_pe": npe, "bypass_muxes": not nobyp, "cells_de_chip": cells_chip,
-             "cells_chip_top": cells_top}
+             "cells_chip_top": cells_top, "compact": COMPACT[fam]}
         # The 9-PE chip picks the smallest device that fits; the other variants use the
         # same device so that their fmax figures compare.
         devices = [ECP5] if fam == "ecp5" else ICE40
@@ -430,7 +436,8 @@ def seeds(args) -> int:
         out = BUILD / "chip_ecp5" / "pe9"
         netlist = out / "netlist.json"
         print("[chip] synthesis of chip_top, 9 PEs", flush=True)
-        yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"), {"NumPe": 9})
+        yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"),
+              {"NumPe": 9, "Compact": COMPACT["ecp5"]})
         dev = ECP5["args"] + ["--freq", str(args.freq), "--lpf-allow-unconstrained"]
         factor, floor = None, args.target_mhz
     per_seed = {}

@@ -23,6 +23,7 @@ module de_chip
 #(
   parameter int unsigned NumPe     = 9,
   parameter int unsigned CarryBug  = 0,
+  parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
   // Test only: PEs whose bus output is corrupted (bit i = PE i), to show bypass works.
   parameter logic [31:0] FaultMask = '0
 ) (
@@ -55,7 +56,8 @@ module de_chip
   // once; the logic is the same either way.
   link_t core_link;
 
-  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .FaultMask(FaultMask)) u_core (
+  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask))
+  u_core (
     .clk_i, .rst_i, .link_i, .blk1z_i, .chain_ctl_i, .chain_i, .chain_o, .bypass_o,
     .link_o(core_link)
   );
@@ -73,6 +75,7 @@ module de_chip_core
 #(
   parameter int unsigned NumPe     = 9,
   parameter int unsigned CarryBug  = 0,
+  parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
   parameter logic [31:0] FaultMask = '0
 ) (
   input  logic             clk_i,
@@ -139,7 +142,7 @@ module de_chip_core
 
     // A bypassed PE is its own bus register: it passes id and data on one clock later
     // and holds the rest of its state in reset (de_pe bypass_i).
-    de_pe #(.CarryBug(CarryBug)) u_pe (
+    de_pe #(.CarryBug(CarryBug), .Compact(Compact)) u_pe (
       .clk_i,
       .rst_i,
       .bypass_i   (byp_pe_q[i]),

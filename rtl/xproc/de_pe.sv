@@ -17,7 +17,11 @@ module de_pe
 #(
   // 1 = reproduce the prototype's carry fault (isa.md section 7, spec/isa.toml [adder]):
   // the carry out of block 1 enters block 2 at bit 1 (adds 2) instead of bit 0.
-  parameter int unsigned CarryBug = 0
+  parameter int unsigned CarryBug = 0,
+  // 1 = the smallest form of the timing-only logic (blk1z_o tested behind the out mux, one
+  // decrement per pass value): the same cycle behaviour in fewer cells, for a part that
+  // is full (the iCE40 chip, docs/fpga.md section 6.3); 0 = the fast form.
+  parameter int unsigned Compact = 0
 ) (
   input  logic             clk_i,
   input  logic             rst_i,        // synchronous, active high
@@ -43,6 +47,9 @@ module de_pe
   // ---- elaboration checks ------------------------------------------------------------
   if (CarryBug > 1) begin : g_bad_carry_bug
     $fatal(1, "de_pe: CarryBug must be 0 or 1, got %0d", CarryBug);
+  end
+  if (Compact > 1) begin : g_bad_compact
+    $fatal(1, "de_pe: Compact must be 0 or 1, got %0d", Compact);
   end
   if (!id_layout_ok()) begin : g_bad_id_layout
     $fatal(1, "de_pkg: id_t does not match the Id*Bit positions");
@@ -203,44 +210,54 @@ module de_pe
   // An address slot decrements block 1 (the countdown, or dX when X was 0) unless it is
   // 0; then a periodic slot reloads P-1 from out_q block 0, which still holds the period
   // this slot passed on unchanged one cycle ago (no extra register), and any other slot
-  // passes the 0. The decrement is a constant one (dm1, kept) picked after the carry
-  // chain, so the chain starts at the input block and not behind the decision;
-  // dec1 = live && (per1 || (id1.addr && xz1_q)), where xz1_q implies id1.addr.
-  // pass1 = z1 ? q1 : (dec1 ? dm1 : in) is one LUT5 of dm1, P - 1, in and two selects
-  // from flops: q1 is 0 unless periodic, and then block 1 (in) is 0 as well when z1.
-  (* keep *) logic sum1, seld1, selq1;
-  (* keep *) logic [BlkW-1:0] pass1, dm1;
+  // passes the 0. dec1 = live && (per1 || (id1.addr && xz1_q)); xz1_q implies id1.addr.
+  (* keep *) logic sum1;
+  (* keep *) logic [BlkW-1:0] pass1;
   logic dec1;
   assign sum1  = active1 && live;
   assign dec1  = live && (per1 || xz1_q);
-  assign seld1 = dec1 && !z1;
-  assign selq1 = z1 && per1 && live;
-  assign dm1   = in_blk[1] - BlkW'(1);
-  assign pass1 = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
   assign out1  = sum1 ? s1[BlkW-1:0] : pass1;
 
-  // out1 == 0 for the next PE (blk1z_d), from the candidates rather than behind the out1
-  // mux, so that the input block is three LUT levels from blk1z_q: the sums by zero_terms
-  // (no carry chain) in kept groups of four bits; q1 = P - 1 = 0 when P = 1; d1 = in - 1 =
-  // 0 only when in is 1, which is the same test of in + src1 with src1 all ones (src1_q
-  // is, when the slot does not add; c1_q is 0 then). Only address slots read the flag
-  // (they never add, but an identifier with both class bits would), so each level is
-  // kept: left to itself, synthesis takes bit 0 from the adder's CCU2C and merges the
-  // levels into wider, deeper functions.
-  (* keep *) logic [BlkW-1:0] tn1, tp1;
-  (* keep *) logic [2:0] zn_g, zp_g;
-  (* keep *) logic zrest, seln1;
-  logic zq1;
-  assign tn1     = zero_terms(in_blk[1], src1, c1_q);
-  assign tp1     = zero_terms(dst1_q, src1, c1_q);
-  for (genvar g = 0; g < 3; g++) begin : g_zero_grp
-    assign zn_g[g] = &tn1[g*BlkW/3 +: BlkW/3];
-    assign zp_g[g] = &tp1[g*BlkW/3 +: BlkW/3];
+  if (Compact == 1) begin : g_pass1_small
+    // One carry chain (in - dec1) and blk1z_d tested on out1 behind its mux.
+    assign pass1   = z1 ? ((per1 && live) ? out_q[0] - BlkW'(1) : '0)
+                        : in_blk[1] - BlkW'(dec1);
+    assign blk1z_d = (out1 == '0);
+  end else begin : g_pass1_fast
+    // The decrement is a constant one (dm1) picked after the carry chain, so the chain
+    // starts at the input block and not behind the decision: pass1 = z1 ? q1 : (dec1 ? dm1
+    // : in) is one LUT5 of dm1, P - 1, in and two selects from flops (q1 is 0 unless
+    // periodic, and then block 1 is 0 as well when z1).
+    (* keep *) logic seld1, selq1;
+    (* keep *) logic [BlkW-1:0] dm1;
+    assign seld1 = dec1 && !z1;
+    assign selq1 = z1 && per1 && live;
+    assign dm1   = in_blk[1] - BlkW'(1);
+    assign pass1 = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
+
+    // out1 == 0 for the next PE (blk1z_d), from the candidates rather than behind the out1
+    // mux, so that the input block is three LUT levels from blk1z_q: the sums by
+    // zero_terms (no carry chain) in kept groups of four bits; q1 = P - 1 = 0 when P = 1;
+    // d1 = in - 1 = 0 only when in is 1, which is the same test of in + src1 with src1 all
+    // ones (src1_q is, when the slot does not add; c1_q is 0 then). Only address slots
+    // read the flag (they never add, but an identifier with both class bits would), so
+    // each level is kept: left to itself, synthesis takes bit 0 from the adder's CCU2C
+    // and merges the levels into wider, deeper functions.
+    (* keep *) logic [BlkW-1:0] tn1, tp1;
+    (* keep *) logic [2:0] zn_g, zp_g;
+    (* keep *) logic zrest, seln1;
+    logic zq1;
+    assign tn1     = zero_terms(in_blk[1], src1, c1_q);
+    assign tp1     = zero_terms(dst1_q, src1, c1_q);
+    for (genvar g = 0; g < 3; g++) begin : g_zero_grp
+      assign zn_g[g] = &tn1[g*BlkW/3 +: BlkW/3];
+      assign zp_g[g] = &tp1[g*BlkW/3 +: BlkW/3];
+    end
+    assign zq1     = !(per1 && live) || (out_q[0] == BlkW'(1));
+    assign seln1   = sum1 ? !prot1_q : seld1;
+    assign zrest   = sum1 ? (prot1_q && &zp_g) : (z1 && zq1);
+    assign blk1z_d = seln1 ? &zn_g : zrest;
   end
-  assign zq1     = !(per1 && live) || (out_q[0] == BlkW'(1));
-  assign seln1   = sum1 ? !prot1_q : seld1;
-  assign zrest   = sum1 ? (prot1_q && &zp_g) : (z1 && zq1);
-  assign blk1z_d = seln1 ? &zn_g : zrest;
 
   // ---- stage 2: block 2 ------------------------------------------------------------------
   logic ev2, active2, wr2;
