@@ -182,8 +182,8 @@ def fmax_of(rep: dict | None) -> float | None:
 def nobypass_chip(out: Path) -> Path:
     """What-if copy of de_chip.sv with the bypass tied off (every PE always used)."""
     src = (ROOT / "rtl/array/de_chip.sv").read_text()
-    new = src.replace(".bypass_i   (byp_pe_q[i]),", ".bypass_i   (1'b0),")
-    new2 = new.replace(".live_i     (live_q[i]),", ".live_i     (1'b1),")
+    new = src.replace(".bypass_i   (pe_byp[i]),", ".bypass_i   (1'b0),")
+    new2 = new.replace(".live_i     (pe_live[i]),", ".live_i     (1'b1),")
     if new == src or new2 == new:
         sys.exit("nobypass what-if: de_chip.sv bypass lines changed; update flow.py")
     out.mkdir(parents=True, exist_ok=True)

@@ -115,12 +115,7 @@ module de_chip_core
   logic [NumPe-1:0]           src_pixv;
   logic [NumPe-1:0]          coll;
   logic [NumPe-1:0]          byp_d, byp_q;
-  // !byp_q, a register of its own for each PE's pass-through terms (de_pe live_i): kept,
-  // so that they do not share the fan-out of byp_q, which resets the whole PE.
-  (* keep *) logic [NumPe-1:0] live_q;
-  // byp_q again, for the PE's own reset only (de_pe bypass_i): kept for the same reason,
-  // so that it can sit in the PE rather than in the configuration shift register.
-  (* keep *) logic [NumPe-1:0] byp_pe_q;
+  logic [NumPe-1:0]          pe_byp, pe_live;  // de_pe bypass_i, live_i
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
   assign bus_id[0]   = link_i.id;
@@ -145,8 +140,8 @@ module de_chip_core
     de_pe #(.CarryBug(CarryBug), .Compact(Compact)) u_pe (
       .clk_i,
       .rst_i,
-      .bypass_i   (byp_pe_q[i]),
-      .live_i     (live_q[i]),
+      .bypass_i   (pe_byp[i]),
+      .live_i     (pe_live[i]),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .blk1z_i    (bus_blk1z[i]),
@@ -255,18 +250,36 @@ module de_chip_core
   end
   assign chain_o.obs = obs_q[0];
 
+  // The PEs' copies of byp_q: !byp_q, a register of its own for each PE's pass-through
+  // terms (de_pe live_i), and byp_q again for the PE's own reset (bypass_i), both kept,
+  // so that neither waits on the other's fan-out nor on the shift register's placement.
+  // A Compact chip (the iCE40, which is full) takes byp_q itself.
+  if (Compact == 1) begin : g_pe_byp_small
+    assign pe_byp  = byp_q;
+    assign pe_live = ~byp_q;
+  end else begin : g_pe_byp_fast
+    (* keep *) logic [NumPe-1:0] live_q, byp_pe_q;
+    always_ff @(posedge clk_i) begin
+      if (rst_i) begin
+        live_q   <= '1;
+        byp_pe_q <= '0;
+      end else begin
+        live_q   <= ~byp_d;
+        byp_pe_q <= byp_d;
+      end
+    end
+    assign pe_byp  = byp_pe_q;
+    assign pe_live = live_q;
+  end
+
   // Configuration and observation registers.
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
       byp_q   <= '0;
-      live_q  <= '1;
-      byp_pe_q <= '0;
       reach_q <= '1;   // no PE bypassed
       obs_q   <= '0;
     end else begin
       byp_q   <= byp_d;
-      live_q  <= ~byp_d;
-      byp_pe_q <= byp_d;
       reach_q <= reach_d;
       obs_q   <= obs_d;
     end

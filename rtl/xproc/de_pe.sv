@@ -433,7 +433,8 @@ module de_pe
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
   assign wr1_d  = wr0;
   assign wr2_d  = wr1;
-  assign src1_d = sum0 ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
+  // (Compact: plain, blk1z_d does not use src1.)
+  assign src1_d = (sum0 || Compact == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
