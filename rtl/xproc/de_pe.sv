@@ -131,10 +131,11 @@ module de_pe
   // 0 (xz1_q) and dX (block 1) is not: fire1 = id1.addr && (per1 ? z1 : xz1_q && !z1).
   logic z1, per1, act_eff;
   // The zero test of block 1 is made by the sender, from its own candidates for the
-  // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below).
-  assign z1        = blk1z_i;
-  // = id1.addr && (id1.sub == SubPeriodic), registered beside id_q (per1_q).
-  assign per1      = per1_q;
+  // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below). A
+  // Compact PE tests the block itself and leaves the flag unused (fewer cells).
+  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : blk1z_i;
+  // = id1.addr && (id1.sub == SubPeriodic), registered beside id_q (per1_q; not Compact).
+  assign per1      = (Compact == 1) ? (id1.addr && (id1.sub == SubPeriodic)) : per1_q;
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
   // sees that slot's decision at once; later slots of the command see the act register:
   // act_eff = id1.addr ? fire1 : act_q. Everything in it but the zero test of block 1 is
