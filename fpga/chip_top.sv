@@ -16,7 +16,8 @@
 
 module chip_top #(
   parameter int unsigned NumPe    = 9,
-  parameter int unsigned CarryBug = 0
+  parameter int unsigned CarryBug = 0,
+  parameter int unsigned Compact  = 0    // de_pe Compact (1: the iCE40 chip, which is full)
 ) (
   input  logic clk_i,
   input  logic rst_i,
@@ -37,6 +38,7 @@ module chip_top #(
 
   logic             rst_q, cfg_mode_q, cfg_bit_q, obs_load_q, obs_shift_q, obs_bit_q;
   logic [InW-1:0]   sh_q;
+  logic             blk1z_q;
   de_pkg::link_t    link_o;
   de_pkg::chain_t   chain_o;
   logic [NumPe-1:0] bypass_o;
@@ -52,14 +54,19 @@ module chip_top #(
     obs_shift_q <= obs_shift_i;
     obs_bit_q   <= obs_bit_i;
     sh_q        <= {sh_q[InW-2:0], sin_i};
+    // de_chip's input block 1 (sh_q[35:24]) is zero next cycle: what the upstream chip's
+    // boundary register provides in an array.
+    blk1z_q     <= (sh_q[34:23] == '0);
   end
 
-  de_chip #(.NumPe(NumPe), .CarryBug(CarryBug)) u_chip (
+  de_chip #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact)) u_chip (
     .clk_i,
     .rst_i      (rst_q),
     // id, data, pix_valid, pix from the shift register; de_chip does not use link_i.coll
     .link_i     ({sh_q[11:0], sh_q[47:12], sh_q[48], sh_q[60:49], 1'b0}),
     .link_o,
+    .blk1z_i    (blk1z_q),
+    .blk1z_o    (),
     .chain_ctl_i({cfg_mode_q, obs_load_q, obs_shift_q}),
     .chain_i    ({cfg_bit_q, obs_bit_q}),
     .chain_o,

@@ -182,16 +182,20 @@ def fmax_of(rep: dict | None) -> float | None:
 def nobypass_chip(out: Path) -> Path:
     """What-if copy of de_chip.sv with the bypass tied off (every PE always used)."""
     src = (ROOT / "rtl/array/de_chip.sv").read_text()
-    new = src.replace(".bypass_i   (byp_q[i]),", ".bypass_i   (1'b0),")
-    if new == src:
+    new = src.replace(".bypass_i   (pe_byp[i]),", ".bypass_i   (1'b0),")
+    new2 = new.replace(".live_i     (pe_live[i]),", ".live_i     (1'b1),")
+    if new == src or new2 == new:
         sys.exit("nobypass what-if: de_chip.sv bypass lines changed; update flow.py")
     out.mkdir(parents=True, exist_ok=True)
     path = out / "de_chip_nobypass.sv"
-    path.write_text(new)
+    path.write_text(new2)
     return path
 
 
 # ---------------------------------------------------------------------------- chip
+COMPACT = {"ecp5": 0, "ice40": 1}   # de_pe Compact per family (chip only)
+
+
 def chip(args) -> int:
     fam = args.family
     tmpl = f"chip_{fam}.ys"
@@ -205,11 +209,14 @@ def chip(args) -> int:
         swap = {"rtl/array/de_chip.sv": str(nobypass_chip(out))} if nobyp else {}
         srcs_top = [swap.get(s, s) for s in core_srcs("fpga", "chip")]
         srcs = [swap.get(s, s) for s in core_srcs("chip")]
-        cells_top = yosys(tmpl, out, "chip_top", srcs_top, {"NumPe": npe})
+        # The iCE40 HX8K is full with 9 PEs: there the PE takes the small form of its
+        # timing-only logic (de_pe Compact, same cycle behaviour; docs/fpga.md 6.3).
+        params = {"NumPe": npe, "Compact": COMPACT[fam]}
+        cells_top = yosys(tmpl, out, "chip_top", srcs_top, params)
         bare = out / "bare"
-        cells_chip = yosys(tmpl, bare, "de_chip", srcs, {"NumPe": npe})
+        cells_chip = yosys(tmpl, bare, "de_chip", srcs, params)
         r = {"num_pe": npe, "bypass_muxes": not nobyp, "cells_de_chip": cells_chip,
-             "cells_chip_top": cells_top}
+             "cells_chip_top": cells_top, "compact": COMPACT[fam]}
         # The 9-PE chip picks the smallest device that fits; the other variants use the
         # same device so that their fmax figures compare.
         devices = [ECP5] if fam == "ecp5" else ICE40
@@ -429,7 +436,8 @@ def seeds(args) -> int:
         out = BUILD / "chip_ecp5" / "pe9"
         netlist = out / "netlist.json"
         print("[chip] synthesis of chip_top, 9 PEs", flush=True)
-        yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"), {"NumPe": 9})
+        yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"),
+              {"NumPe": 9, "Compact": COMPACT["ecp5"]})
         dev = ECP5["args"] + ["--freq", str(args.freq), "--lpf-allow-unconstrained"]
         factor, floor = None, args.target_mhz
     per_seed = {}

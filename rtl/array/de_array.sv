@@ -46,6 +46,10 @@ module de_array
 
   // What chip c receives (link_c[c], chain_c[c]) and passes on (link_c[c+1]).
   link_t  [NumChips:0] link_c;
+  // Timing only: link_c[c].data's block 1 is zero (registered); de_deskew needs no flag.
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic   [NumChips:0] blk1z_c;
+  /* verilator lint_on UNUSEDSIGNAL */
   chain_t [NumChips:0] chain_c;
   logic   [NumChips-1:0] coll_c;
   // Bypass bits per chip: visible in waves and to testbenches through the hierarchy.
@@ -57,6 +61,14 @@ module de_array
   de_skew u_skew (.clk_i, .rst_i, .id_i, .data_i, .id_o(link_c[0].id), .blk_o(link_c[0].data));
   assign {link_c[0].pix_valid, link_c[0].pix, link_c[0].coll} = '0;
   assign chain_c[0] = {cfg_bit_i, 1'b0};
+  // Beside de_skew's block-1 register: chip 0's PE 0 reads its zero test of block 1 from
+  // a flip-flop like every other PE (de_pe blk1z_i).
+  logic skew_blk1z_q;
+  always_ff @(posedge clk_i) begin
+    if (rst_i) skew_blk1z_q <= 1'b1;
+    else       skew_blk1z_q <= (data_i[BlkW +: BlkW] == '0);
+  end
+  assign blk1z_c[0] = skew_blk1z_q;
 
   for (genvar c = 0; c < NumChips; c++) begin : g_chip
     de_chip #(
@@ -67,6 +79,8 @@ module de_array
       .clk_i, .rst_i,
       .link_i     (link_c[c]),
       .link_o     (link_c[c+1]),
+      .blk1z_i    (blk1z_c[c]),
+      .blk1z_o    (blk1z_c[c+1]),
       .chain_ctl_i({cfg_mode_i, obs_load_i, obs_shift_i}),
       .chain_i    (chain_c[c]),
       .chain_o    (chain_c[c+1]),

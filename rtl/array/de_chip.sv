@@ -23,6 +23,7 @@ module de_chip
 #(
   parameter int unsigned NumPe     = 9,
   parameter int unsigned CarryBug  = 0,
+  parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
   // Test only: PEs whose bus output is corrupted (bit i = PE i), to show bypass works.
   parameter logic [31:0] FaultMask = '0
 ) (
@@ -34,6 +35,10 @@ module de_chip
   // breaking "one Refresh active at a time" (7.4.1).
   input  link_t            link_i,
   output link_t            link_o,
+  // Timing only: link_i.data's block 1 is zero, registered upstream (the previous chip's
+  // boundary register, or a register beside the input skew); blk1z_o likewise for link_o.
+  input  logic             blk1z_i,
+  output logic             blk1z_o,
   // configuration chain: shifts one bit per clock while chain_ctl_i.cfg_mode;
   // observation chain: parallel load on .obs_load, shift one bit per clock on .obs_shift
   input  chain_ctl_t       chain_ctl_i,
@@ -51,12 +56,13 @@ module de_chip
   // once; the logic is the same either way.
   link_t core_link;
 
-  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .FaultMask(FaultMask)) u_core (
-    .clk_i, .rst_i, .link_i, .chain_ctl_i, .chain_i, .chain_o, .bypass_o,
+  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask))
+  u_core (
+    .clk_i, .rst_i, .link_i, .blk1z_i, .chain_ctl_i, .chain_i, .chain_o, .bypass_o,
     .link_o(core_link)
   );
 
-  de_chip_bound u_bound (.clk_i, .rst_i, .link_i(core_link), .link_o);
+  de_chip_bound u_bound (.clk_i, .rst_i, .link_i(core_link), .link_o, .blk1z_o);
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
@@ -69,6 +75,7 @@ module de_chip_core
 #(
   parameter int unsigned NumPe     = 9,
   parameter int unsigned CarryBug  = 0,
+  parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
   parameter logic [31:0] FaultMask = '0
 ) (
   input  logic             clk_i,
@@ -76,6 +83,7 @@ module de_chip_core
   /* verilator lint_off UNUSEDSIGNAL */
   input  link_t            link_i,       // .coll not used
   /* verilator lint_on UNUSEDSIGNAL */
+  input  logic             blk1z_i,      // registered: link_i.data's block 1 is zero
   output link_t            link_o,       // combinational: the last PE's bus (or bypass),
                                          // its pixel OR the PEs' pixels, two pixels met here
   input  chain_ctl_t       chain_ctl_i,
@@ -96,22 +104,30 @@ module de_chip_core
 
   logic [NumPe:0][IdW-1:0]   bus_id;
   logic [NumPe:0][DataW-1:0] bus_data;
+  // Registered: bus_data's block 1 is zero. The last PE's is unused: the boundary
+  // register makes its own from link_o (so that the chip's ports stay link_t).
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [NumPe:0]            bus_blk1z;
+  /* verilator lint_on UNUSEDSIGNAL */
   logic [NumPe:0][PixW-1:0]  pix_or;
   logic [NumPe:0]            pixv_or;
   logic [NumPe-1:0][PixW-1:0] src_pix;  // what PE i puts on the pixel chain
   logic [NumPe-1:0]           src_pixv;
   logic [NumPe-1:0]          coll;
   logic [NumPe-1:0]          byp_d, byp_q;
+  logic [NumPe-1:0]          pe_byp, pe_live;  // de_pe bypass_i, live_i
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
   assign bus_id[0]   = link_i.id;
   assign bus_data[0] = link_i.data;
+  assign bus_blk1z[0] = blk1z_i;
   assign pix_or[0]   = link_i.pix_valid ? link_i.pix : '0;
   assign pixv_or[0]  = link_i.pix_valid;
 
   for (genvar i = 0; i < NumPe; i++) begin : g_pe
     logic [IdW-1:0]   pe_id;
     logic [DataW-1:0] pe_data;
+    logic             pe_blk1z;
     logic             pe_pixv;
     logic [PixW-1:0]  pe_pix;
     // Only the observation fields of the debug vector are used inside a chip.
@@ -121,14 +137,17 @@ module de_chip_core
 
     // A bypassed PE is its own bus register: it passes id and data on one clock later
     // and holds the rest of its state in reset (de_pe bypass_i).
-    de_pe #(.CarryBug(CarryBug)) u_pe (
+    de_pe #(.CarryBug(CarryBug), .Compact(Compact)) u_pe (
       .clk_i,
       .rst_i,
-      .bypass_i   (byp_q[i]),
+      .bypass_i   (pe_byp[i]),
+      .live_i     (pe_live[i]),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
+      .blk1z_i    (bus_blk1z[i]),
       .id_o       (pe_id),
       .data_o     (pe_data),
+      .blk1z_o    (pe_blk1z),
       .pix_valid_o(pe_pixv),
       .pix_o      (pe_pix),
       .dbg_o      (pe_dbg)
@@ -154,6 +173,10 @@ module de_chip_core
     end
     assign bus_id[i+1]   = pe_id;
     assign bus_data[i+1] = (FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data;
+    // The garbled block is zero where the PE's was all ones (test only; with no fault
+    // this is the PE's flip-flop).
+    assign bus_blk1z[i+1] = (FaultMask[i] && !byp_q[i]) ? (pe_data[BlkW +: BlkW] == '1)
+                                                          : pe_blk1z;
     // The pixel chain at PE i (below): a bypassed PE's register replaces everything in
     // front of it, a PE in use adds its pixel. At most one PE of the whole array drives a
     // pixel in a cycle, so OR is a mux.
@@ -178,14 +201,22 @@ module de_chip_core
   // path, whatever the configuration) but as an OR of its sources each gated by a
   // registered reach bit: reach_q[n][s] = source s (0: the chip input, k+1: PE k or its
   // bypass register) gets to position n, i.e. no PE in s..n-1 is bypassed. reach_q
-  // follows byp_q (both load from byp_d), so every cycle gives the chain's values.
+  // follows byp_q, so every cycle gives the chain's values. It is shifted with the bypass
+  // bits rather than recomputed from them (one mux per bit, not an AND chain behind the
+  // shift): a bit entering PE 0 moves PE k's bit to PE k+1, so reach[n][s] takes
+  // reach[n-1][s-1], and the chip input reaches n if it reached n-1 and PE 0 is in use.
   logic [NumPe:1][NumPe:0] reach_d, reach_q;
   always_comb begin
-    reach_d = '0;
-    for (int n = 1; n <= NumPe; n++) begin
-      reach_d[n][n] = 1'b1;  // PE n-1 itself: its pixel or its bypass register
-      for (int s = n - 1; s >= 0; s--) begin
-        reach_d[n][s] = reach_d[n][s+1] && !byp_d[s];
+    reach_d = reach_q;
+    if (chain_ctl_i.cfg_mode) begin
+      reach_d = '0;
+      reach_d[1][1] = 1'b1;  // PE 0 itself: its pixel or its bypass register
+      reach_d[1][0] = !chain_i.cfg;
+      for (int n = 2; n <= NumPe; n++) begin
+        reach_d[n][0] = !chain_i.cfg && reach_q[n-1][0];
+        for (int s = 1; s <= n; s++) begin
+          reach_d[n][s] = reach_q[n-1][s-1];
+        end
       end
     end
   end
@@ -219,6 +250,28 @@ module de_chip_core
   end
   assign chain_o.obs = obs_q[0];
 
+  // The PEs' copies of byp_q: !byp_q, a register of its own for each PE's pass-through
+  // terms (de_pe live_i), and byp_q again for the PE's own reset (bypass_i), both kept,
+  // so that neither waits on the other's fan-out nor on the shift register's placement.
+  // A Compact chip (the iCE40, which is full) takes byp_q itself.
+  if (Compact == 1) begin : g_pe_byp_small
+    assign pe_byp  = byp_q;
+    assign pe_live = ~byp_q;
+  end else begin : g_pe_byp_fast
+    (* keep *) logic [NumPe-1:0] live_q, byp_pe_q;
+    always_ff @(posedge clk_i) begin
+      if (rst_i) begin
+        live_q   <= '1;
+        byp_pe_q <= '0;
+      end else begin
+        live_q   <= ~byp_d;
+        byp_pe_q <= byp_d;
+      end
+    end
+    assign pe_byp  = byp_pe_q;
+    assign pe_live = live_q;
+  end
+
   // Configuration and observation registers.
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
@@ -244,7 +297,8 @@ module de_chip_bound
   input  logic  clk_i,
   input  logic  rst_i,
   input  link_t link_i,
-  output link_t link_o
+  output link_t link_o,
+  output logic  blk1z_o   // timing only: link_o.data's block 1 is zero (registered)
 );
   // One register per field, named as the trace harness binds them (sim/harness).
   logic [IdW-1:0]   id_q;
@@ -252,11 +306,19 @@ module de_chip_bound
   logic             pixv_q;
   logic [PixW-1:0]  pix_q;
   logic             coll_q;
+  logic             blk1z_q;
 
   always_ff @(posedge clk_i) begin
     if (rst_i) {id_q, data_q, pixv_q, pix_q, coll_q} <= '0;
     else       {id_q, data_q, pixv_q, pix_q, coll_q} <= link_i;
   end
+  // The next chip's PE 0 reads its zero test of block 1 from a flip-flop too; its input
+  // here is the last PE's bus register, so the test is the only logic in front of it.
+  always_ff @(posedge clk_i) begin
+    if (rst_i) blk1z_q <= 1'b1;
+    else       blk1z_q <= (link_i.data[BlkW +: BlkW] == '0);
+  end
+  assign blk1z_o = blk1z_q;
 
   assign link_o = {id_q, data_q, pixv_q, pix_q, coll_q};
 endmodule

@@ -17,17 +17,28 @@ module de_pe
 #(
   // 1 = reproduce the prototype's carry fault (isa.md section 7, spec/isa.toml [adder]):
   // the carry out of block 1 enters block 2 at bit 1 (adds 2) instead of bit 0.
-  parameter int unsigned CarryBug = 0
+  parameter int unsigned CarryBug = 0,
+  // 1 = the smallest form of the timing-only logic (blk1z_o tested behind the out mux, one
+  // decrement per pass value): the same cycle behaviour in fewer cells, for a part that
+  // is full (the iCE40 chip, docs/fpga.md section 6.3); 0 = the fast form.
+  parameter int unsigned Compact = 0
 ) (
   input  logic             clk_i,
   input  logic             rst_i,        // synchronous, active high
   // Static (a chip's configuration): the PE is replaced by a register. id_o/data_o carry
   // id_i/data_i one clock later and every other register is held in reset.
   input  logic             bypass_i = 1'b0,
+  // = !bypass_i, from a register of its own (timing only): the pass-through terms then do
+  // not wait on bypass_i's fan-out, the reset of every other register.
+  input  logic             live_i = 1'b1,
   input  logic [IdW-1:0]   id_i,         // identifier of the slot at stage 0
   input  logic [DataW-1:0] data_i,       // skewed: [j*12 +: 12] = block j of stage j's slot
+  // Timing only: data_i's block 1 is zero, registered by the sender beside its data_o
+  // (the previous PE's blk1z_o, or a register in front of PE 0). Not architectural.
+  input  logic             blk1z_i,
   output logic [IdW-1:0]   id_o,         // registered, to the next PE
   output logic [DataW-1:0] data_o,       // registered, to the next PE (same skew)
+  output logic             blk1z_o,      // registered: data_o's block 1 is zero
   output logic             pix_valid_o,  // registered: a Refresh's pixel this cycle
   output logic [PixW-1:0]  pix_o,        // registered: D[35:24], zero when not valid
   output logic [DbgW-1:0]  dbg_o         // all state, for the testbench (unused in a chip)
@@ -37,9 +48,28 @@ module de_pe
   if (CarryBug > 1) begin : g_bad_carry_bug
     $fatal(1, "de_pe: CarryBug must be 0 or 1, got %0d", CarryBug);
   end
+  if (Compact > 1) begin : g_bad_compact
+    $fatal(1, "de_pe: Compact must be 0 or 1, got %0d", Compact);
+  end
   if (!id_layout_ok()) begin : g_bad_id_layout
     $fatal(1, "de_pkg: id_t does not match the Id*Bit positions");
   end
+  if (AddCarryBlk == 1) begin : g_bad_carry_blk
+    // blk1z_d's zero test of a block-1 sum takes the carry into bit 0 (zero_terms).
+    $fatal(1, "de_pe: the carry fault must not enter block 1 (AddCarryBlk = 1)");
+  end
+
+  // a + b + cin == 0 (mod 2^BlkW) is the AND of these bits, without the carry chain: sum
+  // bit i is 0 exactly when the carry into bit i equals a[i] ^ b[i], and the carry out of
+  // bit i is then a[i] | b[i]; so every bit is a function of four inputs (one LUT4), side
+  // by side with the adder instead of behind it.
+  function automatic logic [BlkW-1:0] zero_terms(input logic [BlkW-1:0] a,
+                                                 input logic [BlkW-1:0] b, input logic cin);
+    zero_terms[0] = ((a[0] ^ b[0]) == cin);
+    for (int i = 1; i < BlkW; i++) begin
+      zero_terms[i] = ((a[i] ^ b[i]) == (a[i-1] | b[i-1]));
+    end
+  endfunction
 
   // ---- registers (every one is a _d/_q pair) -------------------------------------------
   // Architectural: A, B, C, D as three 12-bit blocks, the flags.
@@ -74,6 +104,10 @@ module de_pe
   logic [BlkW-1:0] src1_d, src1_q, dst1_d, dst1_q, src2_d, src2_q, dst2_d, dst2_q;
   // Timing only, likewise: the register write of the slot in stage 1 / 2 (wr1, wr2).
   logic wr1_d, wr1_q, wr2_d, wr2_q;
+  // Timing only, likewise: out_q's block 1 is zero (the next PE's zero test of block 1).
+  logic blk1z_d, blk1z_q;
+  // Timing only, likewise: the stage-1 slot is a periodic address (per1, from id_q).
+  logic per1_d, per1_q;
 
   // ---- inputs and decode -------------------------------------------------------------
   logic [NumBlk-1:0][BlkW-1:0] in_blk;
@@ -96,13 +130,12 @@ module de_pe
   // An address slot fires when, periodic, its countdown (block 1) is 0, or, range, X was
   // 0 (xz1_q) and dX (block 1) is not: fire1 = id1.addr && (per1 ? z1 : xz1_q && !z1).
   logic z1, per1, act_eff;
-  // The zero test in two kept halves of 6 bits, so that act_eff is one LUT4 of both halves
-  // and aez_q/aenz_q rather than one more level behind a 12-bit test.
-  (* keep *) logic z1_lo, z1_hi;
-  assign z1_lo     = (in_blk[1][BlkW/2-1:0] == '0);
-  assign z1_hi     = (in_blk[1][BlkW-1:BlkW/2] == '0);
-  assign z1        = z1_lo && z1_hi;
-  assign per1      = id1.addr && (id1.sub == SubPeriodic);
+  // The zero test of block 1 is made by the sender, from its own candidates for the
+  // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below). A
+  // Compact PE tests the block itself and leaves the flag unused (fewer cells).
+  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : blk1z_i;
+  // = id1.addr && (id1.sub == SubPeriodic), registered beside id_q (per1_q; not Compact).
+  assign per1      = (Compact == 1) ? (id1.addr && (id1.sub == SubPeriodic)) : per1_q;
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
   // sees that slot's decision at once; later slots of the command see the act register:
   // act_eff = id1.addr ? fire1 : act_q. Everything in it but the zero test of block 1 is
@@ -117,7 +150,11 @@ module de_pe
   assign ev0     = id0.data && !id0.set;
   assign st0     = id0.data && id0.set;
   assign rng0    = id0.addr && (id0.sub != SubPeriodic);
-  assign xz0     = (in_blk[0] == '0);
+  // X - 1 as a constant decrement with its carry out: the carry is 1 unless X is 0, so the
+  // zero test of X comes out of the same carry chain, not from two LUT levels of its own.
+  (* keep *) logic [BlkW:0] dm0;
+  assign dm0     = {1'b0, in_blk[0]} + {1'b0, {BlkW{1'b1}}};
+  assign xz0     = !dm0[BlkW];
   // Protection is decided once per slot, here, and travels with it down the pipeline;
   // pv0 is the part that does not depend on act_eff.
   assign pv0     = ev0 && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
@@ -135,21 +172,18 @@ module de_pe
   // In bypass, every block passes unchanged (live = 0); the rest of the PE is in reset,
   // but not yet in the first cycle of the bypass, hence the explicit term.
   logic live;
-  assign live = !bypass_i;
+  assign live = live_i;
 
   // out0 = sum0 ? s0 : pass0. The select and the pass value are kept as nets of their
   // own, so that the last LUT in front of out_q[0] has the five inputs sum0, pv0, sp0,
   // sn0, pass0 (one PFUMX) rather than a 7-input function of the decisions.
-  (* keep *) logic sum0;
+  // Relative addressing counts X down to 0 and keeps it there: pass0 picks X, X - 1 or 0
+  // after the decrement (a LUT4 of rng0l, the carry, the two bits).
+  (* keep *) logic sum0, rng0l;
   (* keep *) logic [BlkW-1:0] pass0;
-  assign sum0 = active0 && live;
-  always_comb begin
-    pass0 = in_blk[0];
-    if (rng0 && live) begin
-      // Relative addressing: count X down to 0 and keep it there.
-      pass0 = xz0 ? '0 : in_blk[0] - BlkW'(1);
-    end
-  end
+  assign sum0  = active0 && live;
+  assign rng0l = rng0 && live;
+  assign pass0 = rng0l ? (xz0 ? '0 : dm0[BlkW-1:0]) : in_blk[0];
   assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
 
   // ---- stage 1: block 1 ------------------------------------------------------------------
@@ -158,7 +192,8 @@ module de_pe
   logic [BlkW:0] sp1, sn1, s1;
   assign ev1     = id1.data && !id1.set;
   assign active1 = ev1 && act1_q;
-  // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the adder.
+  // = reg_blk(id1.src, a_q[1], b_q[1], c_q[1]), registered (src1_q): no mux before the
+  // adder. All ones when the slot does not add (sum1 = 0), for blk1z_d's test of in - 1.
   assign src1    = src1_q;
   // As in stage 0: both operand sums, prot1_q picks one after the adders.
   assign sp1     = {1'b0, dst1_q} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
@@ -176,17 +211,54 @@ module de_pe
   // An address slot decrements block 1 (the countdown, or dX when X was 0) unless it is
   // 0; then a periodic slot reloads P-1 from out_q block 0, which still holds the period
   // this slot passed on unchanged one cycle ago (no extra register), and any other slot
-  // passes the 0. The decrement subtracts dec1 (not a mux after it): one carry chain.
+  // passes the 0. dec1 = live && (per1 || (id1.addr && xz1_q)); xz1_q implies id1.addr.
   (* keep *) logic sum1;
   (* keep *) logic [BlkW-1:0] pass1;
   logic dec1;
-  logic [BlkW-1:0] q1, d1;
   assign sum1  = active1 && live;
-  assign dec1  = live && (per1 || (id1.addr && xz1_q));
-  assign d1    = in_blk[1] - BlkW'(dec1);
-  assign q1    = (per1 && live) ? out_q[0] - BlkW'(1) : '0;
-  assign pass1 = z1 ? q1 : d1;
+  assign dec1  = live && (per1 || xz1_q);
   assign out1  = sum1 ? s1[BlkW-1:0] : pass1;
+
+  if (Compact == 1) begin : g_pass1_small
+    // One carry chain (in - dec1) and blk1z_d tested on out1 behind its mux.
+    assign pass1   = z1 ? ((per1 && live) ? out_q[0] - BlkW'(1) : '0)
+                        : in_blk[1] - BlkW'(dec1);
+    assign blk1z_d = (out1 == '0);
+  end else begin : g_pass1_fast
+    // The decrement is a constant one (dm1) picked after the carry chain, so the chain
+    // starts at the input block and not behind the decision: pass1 = z1 ? q1 : (dec1 ? dm1
+    // : in) is one LUT5 of dm1, P - 1, in and two selects from flops (q1 is 0 unless
+    // periodic, and then block 1 is 0 as well when z1).
+    (* keep *) logic seld1, selq1;
+    (* keep *) logic [BlkW-1:0] dm1;
+    assign seld1 = dec1 && !z1;
+    assign selq1 = z1 && per1 && live;
+    assign dm1   = in_blk[1] - BlkW'(1);
+    assign pass1 = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
+
+    // out1 == 0 for the next PE (blk1z_d), from the candidates rather than behind the out1
+    // mux, so that the input block is three LUT levels from blk1z_q: the sums by
+    // zero_terms (no carry chain) in kept groups of four bits; q1 = P - 1 = 0 when P = 1;
+    // d1 = in - 1 = 0 only when in is 1, which is the same test of in + src1 with src1 all
+    // ones (src1_q is, when the slot does not add; c1_q is 0 then). Only address slots
+    // read the flag (they never add, but an identifier with both class bits would), so
+    // each level is kept: left to itself, synthesis takes bit 0 from the adder's CCU2C
+    // and merges the levels into wider, deeper functions.
+    (* keep *) logic [BlkW-1:0] tn1, tp1;
+    (* keep *) logic [2:0] zn_g, zp_g;
+    (* keep *) logic zrest, seln1;
+    logic zq1;
+    assign tn1     = zero_terms(in_blk[1], src1, c1_q);
+    assign tp1     = zero_terms(dst1_q, src1, c1_q);
+    for (genvar g = 0; g < 3; g++) begin : g_zero_grp
+      assign zn_g[g] = &tn1[g*BlkW/3 +: BlkW/3];
+      assign zp_g[g] = &tp1[g*BlkW/3 +: BlkW/3];
+    end
+    assign zq1     = !(per1 && live) || (out_q[0] == BlkW'(1));
+    assign seln1   = sum1 ? !prot1_q : seld1;
+    assign zrest   = sum1 ? (prot1_q && &zp_g) : (z1 && zq1);
+    assign blk1z_d = seln1 ? &zn_g : zrest;
+  end
 
   // ---- stage 2: block 2 ------------------------------------------------------------------
   logic ev2, active2, wr2;
@@ -362,7 +434,8 @@ module de_pe
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
   assign wr1_d  = wr0;
   assign wr2_d  = wr1;
-  assign src1_d = reg_blk(id0.src, a_d[1], b_d[1], c_d[1]);
+  // (Compact: plain, blk1z_d does not use src1.)
+  assign src1_d = (sum0 || Compact == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
@@ -372,6 +445,7 @@ module de_pe
   assign out_d    = {out2, out1, out0};
   assign id2_d    = id_q;
   assign xz1_d    = rng0 && xz0;
+  assign per1_d   = id0.addr && (id0.sub == SubPeriodic);
   assign act1_d   = act_eff;
   assign prot1_d  = prot0;
   assign c1_d     = sum0 && s0[BlkW];     // = active0 && s0[BlkW] (in bypass c1_q is held in reset)
@@ -395,14 +469,24 @@ module de_pe
   // exactly as the structural model treats it.
   // The bus registers: the PE's own output, or in bypass its input one clock later. The
   // bypass register of a chip is thus this register, and the next PE's input is a
-  // flip-flop with no OR or mux behind it (docs/fpga.md, section 6.3).
+  // flip-flop with no OR or mux behind it (docs/fpga.md, section 6.3). Beside them the
+  // timing-only registers that follow id_q and out_q through a bypass, so that they are
+  // right in the first cycle after one: per1_q (of id_q), blk1z_q (of out_q), src1_q
+  // (all ones through a bypass, where nothing adds, as in the cycle after it, where
+  // act1_q is still reset).
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
-      id_q  <= '0;
-      out_q <= '0;
+      id_q    <= '0;
+      out_q   <= '0;
+      blk1z_q <= 1'b1;  // out_q is zero
+      per1_q  <= 1'b0;
+      src1_q  <= '0;
     end else begin
-      id_q  <= id_d;
-      out_q <= out_d;
+      id_q    <= id_d;
+      out_q   <= out_d;
+      blk1z_q <= blk1z_d;
+      per1_q  <= per1_d;
+      src1_q  <= src1_d;
     end
   end
 
@@ -439,7 +523,6 @@ module de_pe
       aenz_q   <= 1'b0;
       disx_q   <= 1'b0;
       e0x_q    <= 1'b0;
-      src1_q   <= '0;
       wr1_q    <= 1'b0;
       wr2_q    <= 1'b0;
       dst1_q   <= '0;
@@ -476,7 +559,6 @@ module de_pe
       aenz_q   <= aenz_d;
       disx_q   <= disx_d;
       e0x_q    <= e0x_d;
-      src1_q   <= src1_d;
       wr1_q    <= wr1_d;
       wr2_q    <= wr2_d;
       dst1_q   <= dst1_d;
@@ -488,6 +570,7 @@ module de_pe
   // ---- outputs ----------------------------------------------------------------------------
   assign id_o        = id_q;
   assign data_o      = out_q;
+  assign blk1z_o     = blk1z_q;
   assign pix_valid_o = pixv_q;
   assign pix_o       = pix_q;
 

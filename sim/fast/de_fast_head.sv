@@ -28,10 +28,17 @@ module de_fast_head
 
   de_skew u_skew (.clk_i, .rst_i, .id_i, .data_i, .id_o(skew_link.id), .blk_o(skew_link.data));
   assign {skew_link.pix_valid, skew_link.pix, skew_link.coll} = '0;
+  // As in de_array: chip 0's zero test of block 1, registered beside de_skew.
+  logic skew_blk1z_q;
+  always_ff @(posedge clk_i) begin
+    if (rst_i) skew_blk1z_q <= 1'b1;
+    else       skew_blk1z_q <= (data_i[BlkW +: BlkW] == '0);
+  end
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug)) u_core (
     .clk_i, .rst_i, .link_o, .chain_o,
     .link_i     (skew_link),
+    .blk1z_i    (skew_blk1z_q),
     .chain_ctl_i({cfg_mode_i, obs_load_i, obs_shift_i}),
     .chain_i    ({cfg_bit_i, 1'b0}),
     .bypass_o   (bypass)

@@ -27,6 +27,7 @@ module de_pe_chain
 
   // ---- input skew ----------------------------------------------------------------------
   logic [BlkW-1:0] sk1_d, sk1_q, sk2a_d, sk2a_q, sk2b_d, sk2b_q;
+  logic sk1z_q;  // sk1_q is zero, registered (de_pe blk1z_i of PE 0)
   assign sk1_d  = data_i[BlkW +: BlkW];
   assign sk2a_d = data_i[2*BlkW +: BlkW];
   assign sk2b_d = sk2a_q;
@@ -37,18 +38,22 @@ module de_pe_chain
       sk1_q  <= '0;
       sk2a_q <= '0;
       sk2b_q <= '0;
+      sk1z_q <= 1'b1;
     end else begin
       sk1_q  <= sk1_d;
       sk2a_q <= sk2a_d;
       sk2b_q <= sk2b_d;
+      sk1z_q <= (sk1_d == '0);
     end
   end
 
   // ---- the chain -----------------------------------------------------------------------
   logic [N:0][IdW-1:0]   id_link;
   logic [N:0][DataW-1:0] data_link;
+  logic [N:0]            blk1z_link;
   assign id_link[0]   = id_i;
   assign data_link[0] = {sk2b_q, sk1_q, data_i[BlkW-1:0]};
+  assign blk1z_link[0] = sk1z_q;
 
   for (genvar p = 0; p < N; p++) begin : g_pe
     de_pe #(
@@ -58,8 +63,10 @@ module de_pe_chain
       .rst_i,
       .id_i       (id_link[p]),
       .data_i     (data_link[p]),
+      .blk1z_i    (blk1z_link[p]),
       .id_o       (id_link[p+1]),
       .data_o     (data_link[p+1]),
+      .blk1z_o    (blk1z_link[p+1]),
       .pix_valid_o(pix_valid_o[p]),
       .pix_o      (pix_o[p*PixW +: PixW]),
       .dbg_o      (dbg_o[p*DbgW +: DbgW])
