@@ -401,17 +401,18 @@ bool write_gtkw(const std::string& fst, const std::vector<int>& pes, uint64_t t0
 //   TOP.de_array.g_chip[c].u_chip.u_core... c = 0: head...u_core...; else chip<c>...u_core...
 //   TOP.de_array.g_chip[c].u_chip.u_bound.. c = N-1: tail...u_bound...; else chip<c+1>...u_bound...
 //   TOP.de_array.u_deskew...                tail.de_fast_tail.u_deskew...
-//   TOP.de_array (coll_q, coll_d)           tail.de_fast_tail
+//   TOP.de_array: coll_q                    tail.de_fast_tail
+//   TOP.de_array: skew_blk1z_q              head.de_fast_head (chip 0's block-1 zero flag)
 // Anything else in the flat model is wiring between those instances, recomputed by the
 // settle that follows.
-bool piece_of(const std::string& flat, int n_chips, std::string& key, bool& only_coll) {
+bool piece_of(const std::string& flat, int n_chips, std::string& key, bool& top_scope) {
   static const std::string top = "TOP.de_array";
-  only_coll = false;
+  top_scope = false;
   if (flat.compare(0, top.size(), top) != 0) return false;
   const std::string rest = flat.substr(top.size());
   if (rest.empty()) {
-    key = "tail";
-    only_coll = true;
+    // de_array's own registers live in two pieces: the key is chosen per register.
+    top_scope = true;
     return true;
   }
   if (rest.compare(0, 7, ".u_skew") == 0) return key = "head" + rest, true;
@@ -456,16 +457,20 @@ bool hand_over(de_fast::Array& fa, VerilatedContext& flat_ctx, Vde_array& top, i
   copied = 0;
   for (const auto& kv : *flat_ctx.scopeNameMap()) {
     std::string key;
-    bool only_coll = false;
-    if (!piece_of(kv.first, n_chips, key, only_coll)) continue;
+    bool top_scope = false;
+    if (!piece_of(kv.first, n_chips, key, top_scope)) continue;
     const VerilatedVarNameMap* vars = kv.second->varsp();
     if (!vars) continue;
-    const auto it = pieces.find(key);
     for (const auto& v : *vars) {
       const std::string name = v.first;
-      if (!is_register(name) || (only_coll && name != "coll_q")) continue;
+      if (!is_register(name)) continue;
       VerilatedVar* fv = kv.second->varFind(name.c_str());
       if (fv->isParam() || !fv->datap()) continue;
+      // A register of de_array itself: the collision flag is the tail's, chip 0's zero
+      // flag of block 1 (registered beside de_skew) the head's; any other one has no twin
+      // and is reported below.
+      if (top_scope) key = name == "skew_blk1z_q" ? "head" : "tail";
+      const auto it = pieces.find(key);
       VerilatedVar* pv = it == pieces.end() ? nullptr : it->second->varFind(name.c_str());
       if (!pv || pv->totalSize() != fv->totalSize()) {
         err = std::string("fast-forward: register ") + kv.first + "." + name +
