@@ -45,8 +45,7 @@ module tb_board_sdram #(
   output      logic [31:0]     ref_count_o
 );
   de_sdram_pkg::sdram_out_t sd;
-  logic        m_oe;
-  logic [15:0] m_dq, bus;
+  logic [15:0] bus;
 
   de_board_core #(
     .NumChips(NumChips), .CarryBug(CarryBug), .PfDepth(PfDepth), .SdTckPs(8000),
@@ -61,27 +60,16 @@ module tb_board_sdram #(
     .sd_o(sd), .sd_dq_i(bus)
   );
 
-  // The DQ pins: whoever drives; both at once is the model's DQ violation (and X here).
-  assign bus = sd.dq_oe ? sd.dq : (m_oe ? m_dq : 16'hzzzz);
-
-  logic [15:0] err_seen;
+  // The SDRAM chip behind the board's DQ pins.
   logic [3:0]  err_code;
   logic [31:0] cycle;
-  logic        init_done_m;
-  logic [2:0]  cl_m;
-  logic [9:0]  bl_m;
-
-  sdram_sdr16 #(.TckPs(8000), .TinitNs(SdTinitNs)) u_sdram (
-    .clk_i(clk_sdram_i), .rst_i,
-    .cke_i(sd.cke), .cs_n_i(sd.cs_n), .ras_n_i(sd.ras_n), .cas_n_i(sd.cas_n),
-    .we_n_i(sd.we_n), .ba_i(sd.ba), .a_i(sd.a), .dqm_i(sd.dqm), .dq_i(sd.dq), .dq_o(m_dq),
-    .dq_oe_o(m_oe),
-    .err_count_o, .err_seen_o(err_seen), .err_code_o(err_code), .cycle_o(cycle),
-    .init_done_o(init_done_m), .ref_count_o, .cl_o(cl_m), .bl_o(bl_m)
+  sdram_sdr16_pins #(.TckPs(8000), .TinitNs(SdTinitNs)) u_sdram (
+    .clk_i(clk_sdram_i), .rst_i, .sd_i(sd), .dq_o(bus),
+    .err_count_o, .err_code_o(err_code), .ref_count_o, .cycle_o(cycle)
   );
 
   logic unused;
-  assign unused = ^{err_seen, err_code, cycle, init_done_m, cl_m, bl_m};
+  assign unused = ^{err_code, cycle};
 endmodule
 
 `default_nettype wire
