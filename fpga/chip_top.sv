@@ -36,7 +36,17 @@ module chip_top #(
   localparam int unsigned Grp  = 4;                            // XOR inputs per LUT
   localparam int unsigned NGrp = (OutW + Grp - 1) / Grp;
 
-  logic             rst_q, cfg_mode_q, cfg_bit_q, obs_load_q, obs_shift_q, obs_bit_q;
+  localparam int unsigned RstW = 5 * NumPe + 2;                // de_chip's reset tree
+  logic             cfg_mode_q, cfg_bit_q, obs_load_q, obs_shift_q, obs_bit_q;
+  // The registered reset as RstW copies of one flip-flop (a reset tree: every copy is
+  // the same register of the same input, so reset acts in the same cycle as with one),
+  // each driving one group of de_chip's registers instead of one driving about 3,000.
+  // Each copy is a process of its own marked keep (yosys then keeps the cell; a keep on
+  // the variable alone, or one process for the vector, lets opt_merge fold them into one).
+  logic [RstW-1:0]  rst_q;
+  for (genvar k = 0; k < RstW; k++) begin : g_rst
+    (* keep *) always_ff @(posedge clk_i) rst_q[k] <= rst_i;
+  end
   logic [InW-1:0]   sh_q;
   logic             blk1z_q;
   de_pkg::link_t    link_o;
@@ -47,7 +57,6 @@ module chip_top #(
   logic             fold_q;
 
   always_ff @(posedge clk_i) begin
-    rst_q       <= rst_i;
     cfg_mode_q  <= cfg_mode_i;
     cfg_bit_q   <= cfg_bit_i;
     obs_load_q  <= obs_load_i;
@@ -59,7 +68,7 @@ module chip_top #(
     blk1z_q     <= (sh_q[34:23] == '0);
   end
 
-  de_chip #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact)) u_chip (
+  de_chip #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .RstW(RstW)) u_chip (
     .clk_i,
     .rst_i      (rst_q),
     // id, data, pix_valid, pix from the shift register; de_chip does not use link_i.coll

@@ -25,10 +25,17 @@ module de_chip
   parameter int unsigned CarryBug  = 0,
   parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
   // Test only: PEs whose bus output is corrupted (bit i = PE i), to show bypass works.
-  parameter logic [31:0] FaultMask = '0
+  parameter logic [31:0] FaultMask = '0,
+  // Timing only: copies of the reset on rst_i (a reset tree, below); 1 = one reset.
+  parameter int unsigned RstW      = 1
 ) (
   input  logic             clk_i,
-  input  logic             rst_i,
+  // Synchronous, active high: RstW registered copies of ONE reset, equal in every cycle.
+  // Copy k % RstW resets group k: PE i's register groups are k = 5i .. 5i+3 (de_pe
+  // RstW), its bypass, pixel and observation registers here k = 5i+4, the configuration
+  // k = 5 NumPe, the boundary registers k = 5 NumPe + 1; so RstW = 5 NumPe + 2 gives
+  // every group a copy of its own (fpga/chip_top.sv) and no copy drives the whole chip.
+  input  logic [RstW-1:0]  rst_i,
   // The bus and pixel chain from the upstream chip (its coll is not used: the array ORs
   // the chips' flags) and to the next, registered. link_o.coll: two pixels met on the
   // chain this cycle (registered): two Refreshes were closer than the array is wide,
@@ -56,13 +63,15 @@ module de_chip
   // once; the logic is the same either way.
   link_t core_link;
 
-  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask))
+  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask),
+                 .RstW(RstW))
   u_core (
     .clk_i, .rst_i, .link_i, .blk1z_i, .chain_ctl_i, .chain_i, .chain_o, .bypass_o,
     .link_o(core_link)
   );
 
-  de_chip_bound u_bound (.clk_i, .rst_i, .link_i(core_link), .link_o, .blk1z_o);
+  de_chip_bound u_bound (.clk_i, .rst_i(rst_i[(5 * NumPe + 1) % RstW]), .link_i(core_link),
+                         .link_o, .blk1z_o);
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
@@ -76,11 +85,12 @@ module de_chip_core
   parameter int unsigned NumPe     = 9,
   parameter int unsigned CarryBug  = 0,
   parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
-  parameter logic [31:0] FaultMask = '0
+  parameter logic [31:0] FaultMask = '0,
+  parameter int unsigned RstW      = 1    // copies of the reset (de_chip)
 ) (
   input  logic             clk_i,
-  input  logic             rst_i,
   /* verilator lint_off UNUSEDSIGNAL */
+  input  logic [RstW-1:0]  rst_i,        // equal copies; the boundary's is not used here
   input  link_t            link_i,       // .coll not used
   /* verilator lint_on UNUSEDSIGNAL */
   input  logic             blk1z_i,      // registered: link_i.data's block 1 is zero
@@ -101,6 +111,10 @@ module de_chip_core
   if (NumPe < 1 || NumPe > 32) begin : g_bad_num_pe
     $fatal(1, "de_chip: NumPe must be 1..32, got %0d", NumPe);
   end
+  // Copies of the reset per PE (de_pe RstW): four groups when the chip has a tree.
+  localparam int unsigned PeRstW = (RstW < 4) ? RstW : 4;
+  logic rst_cfg;        // the configuration registers' copy
+  assign rst_cfg = rst_i[(5 * NumPe) % RstW];
 
   logic [NumPe:0][IdW-1:0]   bus_id;
   logic [NumPe:0][DataW-1:0] bus_data;
@@ -115,7 +129,10 @@ module de_chip_core
   logic [NumPe-1:0]           src_pixv;
   logic [NumPe-1:0]          coll;
   logic [NumPe-1:0]          byp_d, byp_q;
-  logic [NumPe-1:0]          pe_byp, pe_live;  // de_pe bypass_i, live_i
+  logic [NumPe-1:0][PeRstW-1:0] pe_byp;    // de_pe bypass_i (equal copies)
+  logic [NumPe-1:0]          pe_live;          // de_pe live_i
+  logic [NumPe-1:0][PeRstW-1:0] pe_rst;    // de_pe rst_i (equal copies)
+  logic [NumPe-1:0]          rst_loc;          // PE i's registers in this module
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
   assign bus_id[0]   = link_i.id;
@@ -137,9 +154,14 @@ module de_chip_core
 
     // A bypassed PE is its own bus register: it passes id and data on one clock later
     // and holds the rest of its state in reset (de_pe bypass_i).
-    de_pe #(.CarryBug(CarryBug), .Compact(Compact)) u_pe (
+    for (genvar g = 0; g < PeRstW; g++) begin : g_rst
+      assign pe_rst[i][g] = rst_i[(5 * i + g) % RstW];
+    end
+    assign rst_loc[i] = rst_i[(5 * i + 4) % RstW];
+
+    de_pe #(.CarryBug(CarryBug), .Compact(Compact), .RstW(PeRstW)) u_pe (
       .clk_i,
-      .rst_i,
+      .rst_i      (pe_rst[i]),
       .bypass_i   (pe_byp[i]),
       .live_i     (pe_live[i]),
       .id_i       (bus_id[i]),
@@ -163,7 +185,7 @@ module de_chip_core
     logic             byp_pixv_q;
     logic [PixW-1:0]  byp_pix_q;
     always_ff @(posedge clk_i) begin
-      if (rst_i || !byp_q[i]) begin
+      if (rst_loc[i] || !byp_q[i]) begin
         byp_pixv_q <= 1'b0;
         byp_pix_q  <= '0;
       end else begin
@@ -188,7 +210,7 @@ module de_chip_core
     // the clock after the bypass bit is set to the clock after it is cleared (byp_id0_q).
     logic byp_id0_q;
     always_ff @(posedge clk_i) begin
-      if (rst_i) byp_id0_q <= 1'b0;
+      if (rst_loc[i]) byp_id0_q <= 1'b0;
       else byp_id0_q <= byp_q[i];
     end
     assign obs_load[i*ObsW +: ObsW] = {pe_dbg[DbgPaLsb:DbgActLsb],
@@ -251,37 +273,49 @@ module de_chip_core
   assign chain_o.obs = obs_q[0];
 
   // The PEs' copies of byp_q: !byp_q, a register of its own for each PE's pass-through
-  // terms (de_pe live_i), and byp_q again for the PE's own reset (bypass_i), both kept,
-  // so that neither waits on the other's fan-out nor on the shift register's placement.
-  // A Compact chip (the iCE40, which is full) takes byp_q itself.
-  if (Compact == 1) begin : g_pe_byp_small
-    assign pe_byp  = byp_q;
-    assign pe_live = ~byp_q;
-  end else begin : g_pe_byp_fast
-    (* keep *) logic [NumPe-1:0] live_q, byp_pe_q;
-    always_ff @(posedge clk_i) begin
-      if (rst_i) begin
-        live_q   <= '1;
-        byp_pe_q <= '0;
-      end else begin
-        live_q   <= ~byp_d;
-        byp_pe_q <= byp_d;
+  // terms (de_pe live_i), and byp_q again for the PE's own reset (bypass_i, one copy per
+  // reset group of the PE), all kept, so that none waits on another's fan-out nor on the
+  // shift register's placement. A Compact chip (the iCE40, which is full) takes byp_q
+  // itself.
+  for (genvar i = 0; i < NumPe; i++) begin : g_pe_byp
+    if (Compact == 1) begin : g_small
+      assign pe_byp[i]  = {PeRstW{byp_q[i]}};
+      assign pe_live[i] = !byp_q[i];
+    end else begin : g_fast
+      // One process per copy, marked keep: yosys keeps such a cell, while a keep on the
+      // variable does not stop opt_merge from folding equal registers into one.
+      logic live_q;
+      logic [PeRstW-1:0] byp_pe_q;
+      (* keep *) always_ff @(posedge clk_i) begin
+        if (rst_loc[i]) live_q <= 1'b1;
+        else            live_q <= !byp_d[i];
       end
+      for (genvar g = 0; g < PeRstW; g++) begin : g_copy
+        (* keep *) always_ff @(posedge clk_i) begin
+          if (rst_loc[i]) byp_pe_q[g] <= 1'b0;
+          else            byp_pe_q[g] <= byp_d[i];
+        end
+      end
+      assign pe_byp[i]  = byp_pe_q;
+      assign pe_live[i] = live_q;
     end
-    assign pe_byp  = byp_pe_q;
-    assign pe_live = live_q;
   end
 
-  // Configuration and observation registers.
+  // Configuration and observation registers; each PE's observation word is reset by
+  // that PE's copy of the reset.
   always_ff @(posedge clk_i) begin
-    if (rst_i) begin
+    if (rst_cfg) begin
       byp_q   <= '0;
       reach_q <= '1;   // no PE bypassed
-      obs_q   <= '0;
     end else begin
       byp_q   <= byp_d;
       reach_q <= reach_d;
-      obs_q   <= obs_d;
+    end
+  end
+  for (genvar i = 0; i < NumPe; i++) begin : g_obs
+    always_ff @(posedge clk_i) begin
+      if (rst_loc[i]) obs_q[i*ObsW +: ObsW] <= '0;
+      else            obs_q[i*ObsW +: ObsW] <= obs_d[i*ObsW +: ObsW];
     end
   end
 

@@ -21,13 +21,23 @@ module de_pe
   // 1 = the smallest form of the timing-only logic (blk1z_o tested behind the out mux, one
   // decrement per pass value): the same cycle behaviour in fewer cells, for a part that
   // is full (the iCE40 chip, docs/fpga.md section 6.3); 0 = the fast form.
-  parameter int unsigned Compact = 0
+  parameter int unsigned Compact = 0,
+  // Timing only: how many copies of the reset (and of the bypass bit) the PE takes, 1..4.
+  // Register group g (RstBus, RstAb, RstCd, RstCtl below) reads copy g % RstW, so that no
+  // copy drives more than about 70 flip-flops (docs/xproc.md section 8).
+  parameter int unsigned RstW = 1
 ) (
   input  logic             clk_i,
-  input  logic             rst_i,        // synchronous, active high
+  // Synchronous, active high. RstW copies of ONE reset, equal in every cycle (registered
+  // copies of the same signal: a reset tree), so the cycle in which reset acts is the
+  // same whichever copy a register reads.
+  input  logic [RstW-1:0]  rst_i,
   // Static (a chip's configuration): the PE is replaced by a register. id_o/data_o carry
-  // id_i/data_i one clock later and every other register is held in reset.
-  input  logic             bypass_i = 1'b0,
+  // id_i/data_i one clock later and every other register is held in reset. RstW equal
+  // copies, as rst_i (the bus group does not read its copy).
+  /* verilator lint_off UNUSEDSIGNAL */
+  input  logic [RstW-1:0]  bypass_i = '0,
+  /* verilator lint_on UNUSEDSIGNAL */
   // = !bypass_i, from a register of its own (timing only): the pass-through terms then do
   // not wait on bypass_i's fan-out, the reset of every other register.
   input  logic             live_i = 1'b1,
@@ -53,6 +63,9 @@ module de_pe
   end
   if (!id_layout_ok()) begin : g_bad_id_layout
     $fatal(1, "de_pkg: id_t does not match the Id*Bit positions");
+  end
+  if (RstW < 1 || RstW > 4) begin : g_bad_rst_w
+    $fatal(1, "de_pe: RstW must be 1..4, got %0d", RstW);
   end
   if (AddCarryBlk == 1) begin : g_bad_carry_blk
     // blk1z_d's zero test of a block-1 sum takes the carry into bit 0 (zero_terms).
@@ -102,8 +115,9 @@ module de_pe
   // Timing only, likewise: the SRC and DST operands of the slots in stages 1 and 2,
   // selected a cycle early from the next values of the register blocks they will read.
   logic [BlkW-1:0] src1_d, src1_q, dst1_d, dst1_q, src2_d, src2_q, dst2_d, dst2_q;
-  // Timing only, likewise: the register write of the slot in stage 1 / 2 (wr1, wr2).
-  logic wr1_d, wr1_q, wr2_d, wr2_q;
+  // Timing only, likewise: the register write of the slot in stage 1 / 2 (wr1, wr2), one
+  // bit per destination ([0] A, [1] B, [2] C), decoded when the slot was a stage earlier.
+  logic [2:0] wr1_d, wr1_q, wr2_d, wr2_q;
   // Timing only, likewise: out_q's block 1 is zero (the next PE's zero test of block 1).
   logic blk1z_d, blk1z_q;
   // Timing only, likewise: the stage-1 slot is a periodic address (per1, from id_q).
@@ -187,7 +201,8 @@ module de_pe
   assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
 
   // ---- stage 1: block 1 ------------------------------------------------------------------
-  logic ev1, active1, wr1, dis1, e0_1, e0en1;
+  logic ev1, active1, dis1, e0_1, e0en1;
+  logic [2:0] wr1;
   logic [BlkW-1:0] src1, out1;
   logic [BlkW:0] sp1, sn1, s1;
   assign ev1     = id1.data && !id1.set;
@@ -199,7 +214,9 @@ module de_pe
   assign sp1     = {1'b0, dst1_q} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
   assign sn1     = {1'b0, in_blk[1]} + {1'b0, src1} + blk_carry_in(c1_q, 1, Bug);
   assign s1      = prot1_q ? sp1 : sn1;
-  // = (ev1 || st1) && act1_q && !prot1_q && (id1.dst != RegNone), i.e. wr0 a cycle ago.
+  // = (ev1 || st1) && act1_q && !prot1_q && (id1.dst != RegNone), i.e. wr0 a cycle ago,
+  // split by id1.dst then (wr1_q): no decode of the identifier in front of the register
+  // blocks' next values, which src1_d/dst1_d select from (the critical path before).
   assign wr1     = wr1_q;
   // Dis and Eval0 are range addresses: fire = X was 0 and dX is not; the slot's kind and
   // X == 0 were registered in its stage 0 (disx_q, e0x_q), the zero test of dX is now.
@@ -261,7 +278,8 @@ module de_pe
   end
 
   // ---- stage 2: block 2 ------------------------------------------------------------------
-  logic ev2, active2, wr2;
+  logic ev2, active2;
+  logic [2:0] wr2;
   logic [BlkW-1:0] src2, out2;
   // The carry out of block 2 (bit 35) is dropped: arithmetic wraps modulo 2^36.
   /* verilator lint_off UNUSEDSIGNAL */
@@ -275,7 +293,8 @@ module de_pe
   assign sp2     = {1'b0, dst2_q} + {1'b0, src2} + blk_carry_in(c2_q, 2, Bug);
   assign sn2     = {1'b0, in_blk[2]} + {1'b0, src2} + blk_carry_in(c2_q, 2, Bug);
   assign s2      = prot2_q ? sp2 : sn2;
-  // = (ev2 || st2) && act2_q && !prot2_q && (id2.dst != RegNone), i.e. wr1 a cycle ago.
+  // = (ev2 || st2) && act2_q && !prot2_q && (id2.dst != RegNone), i.e. wr1 a cycle ago,
+  // split by destination as wr1.
   assign wr2     = wr2_q;
   assign out2    = (active2 && live) ? s2[BlkW-1:0] : in_blk[2];
 
@@ -290,7 +309,7 @@ module de_pe
   /* verilator lint_on UNUSEDSIGNAL */
   always_comb begin
     a2_sign_next = a_q[2][BlkW-1];
-    if (wr2 && (id2.dst == RegA)) begin
+    if (wr2[0]) begin
       a2_sign_next = in_blk[2][BlkW-1];
     end
     if (id2.refresh) begin
@@ -337,20 +356,13 @@ module de_pe
         default: c_d[0] = in_blk[0];
       endcase
     end
-    if (wr1) begin
-      case (id1.dst)
-        RegA:    a_d[1] = in_blk[1];
-        RegB:    b_d[1] = in_blk[1];
-        default: c_d[1] = in_blk[1];
-      endcase
-    end
-    if (wr2) begin
-      case (id2.dst)
-        RegA:    a_d[2] = in_blk[2];
-        RegB:    b_d[2] = in_blk[2];
-        default: c_d[2] = in_blk[2];
-      endcase
-    end
+    // Stages 1 and 2: the write decoded by destination a stage earlier (wr1, wr2).
+    if (wr1[0]) a_d[1] = in_blk[1];
+    if (wr1[1]) b_d[1] = in_blk[1];
+    if (wr1[2]) c_d[1] = in_blk[1];
+    if (wr2[0]) a_d[2] = in_blk[2];
+    if (wr2[1]) b_d[2] = in_blk[2];
+    if (wr2[2]) c_d[2] = in_blk[2];
     // A Refresh clears block j of A-D in its stage j; the clear wins over any write.
     if (id0.refresh) begin
       a_d[0] = '0;
@@ -432,7 +444,8 @@ module de_pe
   assign e0x_d  = xz1_d && (id0.sub == SubEval0);
   // wr1/wr2 are wr0/wr1 one cycle on; the slot in stage 0 (1) reads block 1 (2) next
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
-  assign wr1_d  = wr0;
+  assign wr1_d  = {wr0 && (id0.dst == RegC), wr0 && (id0.dst == RegB),
+                   wr0 && (id0.dst == RegA)};
   assign wr2_d  = wr1;
   // (Compact: plain, blk1z_d does not use src1.)
   assign src1_d = (sum0 || Compact == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
@@ -474,8 +487,18 @@ module de_pe
   // right in the first cycle after one: per1_q (of id_q), blk1z_q (of out_q), src1_q
   // (all ones through a bypass, where nothing adds, as in the cycle after it, where
   // act1_q is still reset).
+  // Reset groups (timing only): each group reads its own copy of the reset and of the
+  // bypass bit (RstW copies, all equal), so that a copy fans out to a group's set/reset
+  // logic, not to the ~300 flip-flops of the PE (docs/fpga.md section 6.3, third pass).
+  localparam int unsigned RstBus = 0, RstAb = 1, RstCd = 2, RstCtl = 3;
+  logic rst_bus, hold_ab, hold_cd, hold_ctl;
+  assign rst_bus  = rst_i[RstBus % RstW];
+  assign hold_ab  = rst_i[RstAb % RstW]  || bypass_i[RstAb % RstW];
+  assign hold_cd  = rst_i[RstCd % RstW]  || bypass_i[RstCd % RstW];
+  assign hold_ctl = rst_i[RstCtl % RstW] || bypass_i[RstCtl % RstW];
+
   always_ff @(posedge clk_i) begin
-    if (rst_i) begin
+    if (rst_bus) begin
       id_q    <= '0;
       out_q   <= '0;
       blk1z_q <= 1'b1;  // out_q is zero
@@ -492,11 +515,25 @@ module de_pe
 
   // Everything else; a bypassed PE holds it in reset (no pixel, an all-zero state).
   always_ff @(posedge clk_i) begin
-    if (rst_i || bypass_i) begin
-      a_q      <= '0;
-      b_q      <= '0;
-      c_q      <= '0;
-      d_q      <= '0;
+    if (hold_ab) begin
+      a_q <= '0;
+      b_q <= '0;
+    end else begin
+      a_q <= a_d;
+      b_q <= b_d;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    if (hold_cd) begin
+      c_q <= '0;
+      d_q <= '0;
+    end else begin
+      c_q <= c_d;
+      d_q <= d_d;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    if (hold_ctl) begin
       pa_q     <= 1'b0;
       pb_q     <= 1'b0;
       pc_q     <= 1'b0;
@@ -523,16 +560,12 @@ module de_pe
       aenz_q   <= 1'b0;
       disx_q   <= 1'b0;
       e0x_q    <= 1'b0;
-      wr1_q    <= 1'b0;
-      wr2_q    <= 1'b0;
+      wr1_q    <= '0;
+      wr2_q    <= '0;
       dst1_q   <= '0;
       src2_q   <= '0;
       dst2_q   <= '0;
     end else begin
-      a_q      <= a_d;
-      b_q      <= b_d;
-      c_q      <= c_d;
-      d_q      <= d_d;
       pa_q     <= pa_d;
       pb_q     <= pb_d;
       pc_q     <= pc_d;
