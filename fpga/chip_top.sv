@@ -36,7 +36,7 @@ module chip_top #(
   localparam int unsigned Grp  = 4;                            // XOR inputs per LUT
   localparam int unsigned NGrp = (OutW + Grp - 1) / Grp;
 
-  localparam int unsigned RstW = 5 * NumPe + 2;                // de_chip's reset tree
+  localparam int unsigned RstW = (Compact == 1) ? 1 : 5 * NumPe + 2;  // reset tree (not iCE40)
   logic             cfg_mode_q, cfg_bit_q, obs_load_q, obs_shift_q, obs_bit_q;
   // The registered reset as RstW copies of one flip-flop (a reset tree: every copy is
   // the same register of the same input, so reset acts in the same cycle as with one),
