@@ -24,7 +24,7 @@ module de_pe
   parameter int unsigned Compact = 0,
   // Timing only: how many copies of the reset (and of the bypass bit) the PE takes, 1..4.
   // Register group g (RstBus, RstAb, RstCd, RstCtl below) reads copy g % RstW, so that no
-  // copy drives more than about 70 flip-flops (docs/xproc.md section 8).
+  // copy drives more than about 90 flip-flops (docs/xproc.md section 8).
   parameter int unsigned RstW = 1
 ) (
   input  logic             clk_i,
@@ -444,6 +444,7 @@ module de_pe
   assign e0x_d  = xz1_d && (id0.sub == SubEval0);
   // wr1/wr2 are wr0/wr1 one cycle on; the slot in stage 0 (1) reads block 1 (2) next
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
+  // Split by destination (wr0 implies id0.dst != RegNone, so the case's default is C).
   assign wr1_d  = {wr0 && (id0.dst == RegC), wr0 && (id0.dst == RegB),
                    wr0 && (id0.dst == RegA)};
   assign wr2_d  = wr1;
