@@ -281,7 +281,11 @@ module de_span_array
   logic          last_d, last_q;
   tok_t          cur_d, cur_q;        // the running pass's token template
   tok_t          iss;                 // token issued this clock (vld = 0: none)
-  logic          hazard;
+  logic          hazard;              // the stall test as written (checked against hz_q)
+  // The stall test a clock ahead (hz_q): for each column the walk can be at next clock
+  // (the same, the next, or the next pass's first), against the tokens that will then be
+  // in the first HzStages stages. The walk then reads the test from a flip-flop.
+  logic          hz_d, hz_q, hz_stay, hz_adv, hz_new, adv;
   // The next pass, decoded a clock ahead from the pass table (entry ld_cnt): its token
   // template and column range. It goes into the issue registers when the engine is idle,
   // or (Prefetch) in the clock the running pass issues its last token.
@@ -302,6 +306,22 @@ module de_span_array
         hazard = 1'b1;
       end
     end
+  end
+
+  // Next clock, stage s + 1 holds today's stage s, and stage 0 today's issued token. That
+  // token is at col_q, which only the next pass can meet again: a pass's columns rise.
+  always_comb begin
+    hz_stay = 1'b0;
+    hz_adv  = 1'b0;
+    hz_new  = iss.vld && !iss.nul && (col_q == ncol_q);
+    for (int s = 0; s + 1 < HzStages; s++) begin
+      if (tok_q[s].vld && !tok_q[s].nul) begin
+        if (tok_q[s].col == col_q) hz_stay = 1'b1;
+        if (tok_q[s].col == cnx_q) hz_adv = 1'b1;
+        if (tok_q[s].col == ncol_q) hz_new = 1'b1;
+      end
+    end
+    hz_d = xfer ? hz_new : adv ? hz_adv : hz_stay;
   end
 
   hdr_t hr;
@@ -362,6 +382,7 @@ module de_span_array
     cnx_d     = cnx_q;
     last_d    = last_q;
     cur_d     = cur_q;
+    adv       = 1'b0;
     iss_cnt_d = iss_cnt_q;
     iss       = cur_q;
     iss.vld   = 1'b0;
@@ -392,8 +413,9 @@ module de_span_array
         fin       = 1'b1;
       end
     end else if (run_q) begin
-      if (cur_q.nul || !hazard) begin
+      if (cur_q.nul || !hz_q) begin
         iss.vld = 1'b1;
+        adv     = 1'b1;
         col_d   = cnx_q;
         // cnx_q < end_q <= NumCols here whenever the walk goes on, so the sum below
         // cannot wrap CW bits.
@@ -688,6 +710,7 @@ module de_span_array
       step_q    <= '0;
       cnx_q     <= '0;
       last_q    <= 1'b1;
+      hz_q      <= 1'b0;
       cur_q     <= '0;
       pixv_q    <= 1'b0;
       pix_q     <= '0;
@@ -737,6 +760,7 @@ module de_span_array
       step_q    <= step_d;
       cnx_q     <= cnx_d;
       last_q    <= last_d;
+      hz_q      <= hz_d;
       cur_q     <= cur_d;
       pixv_q    <= pixv_d;
       pix_q     <= pix_d;
@@ -787,6 +811,9 @@ module de_span_array
     if (!rst_i && run_q && !cur_q.rfr &&
         (cnx_q != col_q + step_q || last_q != (col_q + step_q >= end_q)))
       $fatal(1, "de_span_array: walk look-ahead out of step at column %0d", col_q);
+    if (!rst_i && run_q && !cur_q.rfr && !cur_q.nul && hz_q != hazard)
+      $fatal(1, "de_span_array: stall test a clock ahead (%0d) differs at column %0d",
+             hz_q, col_q);
     if (!rst_i && commit && !ref_we && hdr_w.one != (hdr_w.cnx >= hdr_w.cend))
       $fatal(1, "de_span_array: first-column-is-last flag wrong for X %0d", x_q);
   end
