@@ -258,11 +258,33 @@ module de_span_array
   // One memory per slot position: one write port (the front end) and one read port,
   // which is what maps onto distributed RAM. It is read for the token one stage ahead
   // and registered, so no RAM read sits in front of a stage's adder.
+  // The write is registered first (a clock late): the accept decision in front of it,
+  // decoded from the incoming identifier, otherwise ran on into the write enables of all
+  // K memories. A slot is read only after its pass is committed (a clock after the slot
+  // at the earliest), seen by the issue a clock later and walked after that, so the late
+  // write is always in place before the first read.
+  logic          sw_we_q;
+  logic [3:0]    sw_j_q;
+  logic [PW-1:0] sw_ptr_q;
+  slot_t         sw_data_q;
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      sw_we_q <= 1'b0;
+    end else begin
+      sw_we_q <= slot_we;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    sw_j_q    <= nslot_q;
+    sw_ptr_q  <= wr_ptr;
+    sw_data_q <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
+  end
+
   for (genvar j = 0; j < K; j++) begin : g_slot_mem
     (* ram_style = "distributed" *) slot_t mem [NPass];
     always_ff @(posedge clk_i) begin
-      if (slot_we && (nslot_q == 4'(j))) begin
-        mem[wr_ptr] <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
+      if (sw_we_q && (sw_j_q == 4'(j))) begin
+        mem[sw_ptr_q] <= sw_data_q;
       end
       slot_q[j] <= mem[tok_q[j + 1].ptr];
     end
