@@ -240,12 +240,15 @@ module de_sdram_ctrl #(
 
   logic                p_ok_d, p_ok_q, p_rd_q, p_hit_q, p_idle_q;
   logic [BankBits-1:0] p_bank_q;
+  // The request taken is the one whose compare p_ok_q vouches for, so its port's valid
+  // is not in front of the step (a request stays until it is taken; checked in
+  // simulation below).
   logic accept, take_rd, take_wr;
   assign accept         = (state_q == SRun) && !cur_valid_q && !ref_due_q && p_ok_q;
   assign rd_req_ready_o = accept && p_rd_q;
   assign wr_ready_o     = accept && !p_rd_q;
-  assign take_rd        = accept && p_rd_q && rd_req_valid_i;
-  assign take_wr        = accept && !p_rd_q && wr_valid_i;
+  assign take_rd        = accept && p_rd_q;
+  assign take_wr        = accept && !p_rd_q;
   assign c_bank         = cur_valid_q ? cur_bank : p_bank_q;
 
   // ---------------------------------------------------------------- command decision
@@ -509,6 +512,19 @@ module de_sdram_ctrl #(
       p_bank_q <= new_bank;
     end
   end
+
+`ifdef VERILATOR
+  // The ports' contract: a request waits on its port, unchanged, until it is taken.
+  logic [AW-1:0] p_addr_q;
+  always_ff @(posedge clk_i) begin
+    p_addr_q <= rd_req_valid_i ? rd_req_addr_i : wr_addr_i;
+    if (!rst_q && p_ok_q && (p_rd_q ? !rd_req_valid_i : !wr_valid_i))
+      $fatal(1, "de_sdram_ctrl: a waiting %s request was withdrawn",
+             p_rd_q ? "read" : "write");
+    if (!rst_q && p_ok_q && (p_rd_q ? rd_req_addr_i : wr_addr_i) != p_addr_q)
+      $fatal(1, "de_sdram_ctrl: a waiting request's address changed");
+  end
+`endif
 
   // ---------------------------------------------------------------- read data
   always_comb begin

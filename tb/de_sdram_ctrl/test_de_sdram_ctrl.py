@@ -4,8 +4,10 @@ Toplevel tb_sdram_ctrl.sv: the controller drives sim/models/sdram_sdr16.sv over 
 SDRAM pins; the model counts every timing or protocol violation (err_count_o).
 Structure:
   Driver   - per clock (falling edge) offers at most one read request (4 words) and one
-             write (1 word); a request counts as taken when ready was high (ready does
-             not depend on valid, so it is read before driving).
+             write (1 word), each kept on its port until taken (the controller's
+             contract; it stops the simulation otherwise); a request counts as taken
+             when its port's ready was high (the readies depend on flip-flops only, not
+             on valid, so they are read before driving).
   Monitor  - samples rd_valid_o / rd_data_o / rd_tag_o once per clock.
   Model    - a dict word address -> 32-bit word, updated in acceptance order (the
              controller serves requests in order), and the queue of expected read words.
@@ -150,10 +152,11 @@ async def random_rw(dut):
     n_ops = int(os.environ.get("SDRAM_CTRL_OPS", "600"))
     pend_rd = pend_wr = None
     done = 0
-    while done < n_ops:
-        if pend_rd is None and rng.random() < 0.4:
+    # A request stays on its port until it is taken (the controller checks that).
+    while done < n_ops or pend_rd is not None or pend_wr is not None:
+        if pend_rd is None and done < n_ops and rng.random() < 0.4:
             pend_rd = (rand_addr() & ~3, rng.randrange(4))
-        if pend_wr is None and rng.random() < 0.6:
+        if pend_wr is None and done < n_ops and rng.random() < 0.6:
             pend_wr = (rand_addr(), rng.randrange(1 << 32))
         took_rd, took_wr = await b.clock(pend_rd, pend_wr)
         if took_rd:
@@ -245,7 +248,8 @@ async def stream(dut):
     b.words, b.first_word = 0, None
     start = b.cycle
     req = None
-    while b.cycle - start < cycles:
+    # The window's last request is kept on the port until it is taken.
+    while b.cycle - start < cycles or req is not None:
         if req is None:
             req = (addr_of(c, 100 + c, 0) + pos[c], c)
         took, _ = await b.clock(req, None)
