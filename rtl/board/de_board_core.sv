@@ -5,7 +5,7 @@
 //                                                     v
 //                                              display_controller (3 arrays, NumBuf 1)
 //                                                     |
-//   tmds_o[2:0] <- de_tmds_enc x 3 <- rgb8 / hsync / vsync / blank
+//   tmds_o[2:0] <- de_tmds_enc x 3 <- rgb8_o / hsync_o / vsync_o / blank_o
 //
 // The pixel clock (clk_i), plus clk_core_i for the UART (always: 3 Mbaud needs a clock
 // with an integer bit period, de_uart_link) and for the span-serial arrays when
@@ -31,14 +31,14 @@ module de_board_core #(
   parameter int unsigned TimeoutBits = 22,
   parameter int unsigned BufDepth    = 16,
   parameter int unsigned MaxLines    = 512,
-  parameter int unsigned TestHActive = 16,
-  parameter int unsigned TestHFp     = 2,
-  parameter int unsigned TestHSync   = 3,
-  parameter int unsigned TestHBp     = 3,
-  parameter int unsigned TestVActive = 6,
-  parameter int unsigned TestVFp     = 1,
-  parameter int unsigned TestVSync   = 2,
-  parameter int unsigned TestVBp     = 2,
+  parameter int unsigned TestHActive = 32'(de_pkg::VideoTestDefault.h_act),
+  parameter int unsigned TestHFp     = 32'(de_pkg::VideoTestDefault.h_fp),
+  parameter int unsigned TestHSync   = 32'(de_pkg::VideoTestDefault.h_sync),
+  parameter int unsigned TestHBp     = 32'(de_pkg::VideoTestDefault.h_bp),
+  parameter int unsigned TestVActive = 32'(de_pkg::VideoTestDefault.v_act),
+  parameter int unsigned TestVFp     = 32'(de_pkg::VideoTestDefault.v_fp),
+  parameter int unsigned TestVSync   = 32'(de_pkg::VideoTestDefault.v_sync),
+  parameter int unsigned TestVBp     = 32'(de_pkg::VideoTestDefault.v_bp),
   parameter int unsigned SpanArray   = 0,      // 1: span-serial arrays on clk_core_i
   parameter int unsigned SpanLatency = 300,    // their Refresh -> column 0, pixel clocks
   // Their pixel -> core FIFO, log2 slots: 2,048 slots hold the CAD scene's paced backlog
@@ -158,8 +158,6 @@ module de_board_core #(
   logic [NumCh-1:0][11:0] rgb12;
   logic [NumCh-1:0]       cfg_bit_o, obs_bit_o;
   /* verilator lint_on UNUSEDSIGNAL */
-  logic [NumCh-1:0][7:0]  rgb8;
-  logic                   hsync, vsync, blank;
 
   display_controller #(
     .NumChips   (NumChips),
@@ -194,10 +192,7 @@ module de_board_core #(
     .out8_shift_i   (out8_shift),
     .out8_sat_i     (out8_sat),
     .rgb_o          (rgb12),
-    .rgb8_o         (rgb8),
-    .hsync_o        (hsync),
-    .vsync_o        (vsync),
-    .blank_o        (blank),
+    .rgb8_o, .hsync_o, .vsync_o, .blank_o,   // the core's own outputs, read by the TMDS
     .align_err_o    (align_err),
     .pix_collision_o(pix_collision),
     .cfg_mode_i     (1'b0),
@@ -218,13 +213,14 @@ module de_board_core #(
 
   // ------------------------------------------------------------------ TMDS
   de_tmds_enc u_tmds_b (
-    .clk_i, .rst_i, .de_i(!blank), .data_i(rgb8[2]), .c_i({vsync, hsync}), .sym_o(tmds_o[0])
+    .clk_i, .rst_i, .de_i(!blank_o), .data_i(rgb8_o[2]), .c_i({vsync_o, hsync_o}),
+    .sym_o(tmds_o[0])
   );
   de_tmds_enc u_tmds_g (
-    .clk_i, .rst_i, .de_i(!blank), .data_i(rgb8[1]), .c_i(2'b00), .sym_o(tmds_o[1])
+    .clk_i, .rst_i, .de_i(!blank_o), .data_i(rgb8_o[1]), .c_i(2'b00), .sym_o(tmds_o[1])
   );
   de_tmds_enc u_tmds_r (
-    .clk_i, .rst_i, .de_i(!blank), .data_i(rgb8[0]), .c_i(2'b00), .sym_o(tmds_o[2])
+    .clk_i, .rst_i, .de_i(!blank_o), .data_i(rgb8_o[0]), .c_i(2'b00), .sym_o(tmds_o[2])
   );
 
   // ------------------------------------------------------------------ status
@@ -235,13 +231,9 @@ module de_board_core #(
     else       heart_q <= heart_d;
   end
 
-  assign led_o   = {pending || malformed != 8'd0 || late_words != 8'd0,
-                    |pix_collision, align_err, 2'b00,
-                    cmd_count != 16'd0, chk_count != 16'd0 || ferr_count != 16'd0, heart_q};
-  assign rgb8_o  = rgb8;
-  assign hsync_o = hsync;
-  assign vsync_o = vsync;
-  assign blank_o = blank;
+  assign led_o = {pending || malformed != 8'd0 || late_words != 8'd0,
+                  |pix_collision, align_err, 2'b00,
+                  cmd_count != 16'd0, chk_count != 16'd0 || ferr_count != 16'd0, heart_q};
 endmodule
 
 `default_nettype wire

@@ -153,6 +153,12 @@ module de_sdram_ctrl #(
     logic [TagW-1:0] tag;
   } beat_t;
 
+  // ---------------------------------------------------------------- reset
+  // A copy of rst_i in a register of this module's own: the reset's fanout here is this
+  // module's flip-flops, not the whole clock domain's net (one clock later).
+  logic rst_q;
+  always_ff @(posedge clk_i) rst_q <= rst_i;
+
   // ---------------------------------------------------------------- state
   state_e state_d, state_q;
   logic [19:0] wait_d, wait_q;
@@ -214,21 +220,36 @@ module de_sdram_ctrl #(
   logic [BankBits-1:0]  cur_bank;
   logic [RowBits-1:0]   cur_row;
   logic [ColBits-2:0]   cur_colw;
+  logic [BankBits-1:0]  c_bank;            // the bank of the c_* flags (below)
   assign cur_bank = cur_addr_q[AW-1 -: BankBits];
   assign cur_row  = cur_addr_q[ColBits-1 +: RowBits];
   assign cur_colw = cur_addr_q[ColBits-2:0];
 
-  // The request that would be accepted now (reads first).
+  // The request waiting at the ports (reads first). Its open-row compare is made while
+  // it waits, and registered: p_hit_q (its bank has its row open), p_idle_q (its bank is
+  // idle), p_bank_q, for the port p_rd_q says (1: read), valid when p_ok_q. p_ok_q says
+  // that the compare was made in the clock before from the request still waiting now
+  // (a request stays on its port, unchanged, until it is taken) and from the bank state
+  // still in force (no PRECHARGE or ACT went in that clock). So the request is taken at
+  // the soonest in the second clock it waits, and its first step is a flip-flop then.
   logic [BankBits-1:0] new_bank;
   logic [RowBits-1:0]  new_row;
   assign new_bank = rd_req_valid_i ? rd_req_addr_i[AW-1 -: BankBits] : wr_addr_i[AW-1 -: BankBits];
   assign new_row  = rd_req_valid_i ? rd_req_addr_i[ColBits-1 +: RowBits] :
                                      wr_addr_i[ColBits-1 +: RowBits];
 
-  logic accept;
-  assign accept         = (state_q == SRun) && !cur_valid_q && !ref_due_q;
-  assign rd_req_ready_o = accept;
-  assign wr_ready_o     = accept && !rd_req_valid_i;
+  logic                p_ok_d, p_ok_q, p_rd_q, p_hit_q, p_idle_q;
+  logic [BankBits-1:0] p_bank_q;
+  // The request taken is the one whose compare p_ok_q vouches for, so its port's valid
+  // is not in front of the step (a request stays until it is taken; checked in
+  // simulation below).
+  logic accept, take_rd, take_wr;
+  assign accept         = (state_q == SRun) && !cur_valid_q && !ref_due_q && p_ok_q;
+  assign rd_req_ready_o = accept && p_rd_q;
+  assign wr_ready_o     = accept && !p_rd_q;
+  assign take_rd        = accept && p_rd_q;
+  assign take_wr        = accept && !p_rd_q;
+  assign c_bank         = cur_valid_q ? cur_bank : p_bank_q;
 
   // ---------------------------------------------------------------- command decision
   // Each command of the request is one AND of its step and its registered gap flags, so
@@ -327,24 +348,23 @@ module de_sdram_ctrl #(
         if (!cur_valid_q) begin
           if (ref_due_q) begin
             state_d = SRefPre;
-          end else if (rd_req_valid_i) begin
+          end else if (take_rd) begin
             cur_valid_d = 1'b1;
             cur_write_d = 1'b0;
             cur_addr_d  = {rd_req_addr_i[AW-1:2], 2'b00};
             cur_tag_d   = rd_req_tag_i;
-          end else if (wr_valid_i) begin
+          end else if (take_wr) begin
             cur_valid_d = 1'b1;
             cur_write_d = 1'b1;
             cur_beat_d  = 1'b0;
             cur_addr_d  = wr_addr_i;
             cur_data_d  = wr_data_i;
           end
-          // No command goes in this clock, so open_q / row_q are final: the new request's
-          // first command is decided here, from the port (new_*), off the command path.
-          if (cur_valid_d) begin
-            st_rw_d  = open_q[new_bank] && (row_q[new_bank] == new_row);
-            st_act_d = !open_q[new_bank];
-            st_pre_d = !st_rw_d && !st_act_d;
+          // The new request's first command, from its compare made a clock ago (p_*_q).
+          if (take_rd || take_wr) begin
+            st_rw_d  = p_hit_q;
+            st_act_d = p_idle_q;
+            st_pre_d = !p_hit_q && !p_idle_q;
           end
         end
         // Address and data follow the request's step alone (the pins carry a NOP when
@@ -461,13 +481,50 @@ module de_sdram_ctrl #(
     // and the refresh's all-bank PRECHARGE comes with no request; the next request's
     // flags are computed afresh when it is accepted), so the mask is the command itself,
     // not the per-bank strobe selected by the bank: one level less behind the decision.
-    c_rcd_d = f_rcd_d[cur_addr_d[AW-1 -: BankBits]] && !do_act;
-    c_rc_d  = f_rc_d[cur_addr_d[AW-1 -: BankBits]] && !do_act;
-    c_ras_d = f_ras_d[cur_addr_d[AW-1 -: BankBits]] && !do_act;
-    c_rp_d  = f_rp_d[cur_addr_d[AW-1 -: BankBits]] && !do_pre;
-    c_wr_d  = f_wr_d[cur_addr_d[AW-1 -: BankBits]] && !(do_wr || do_wr2);
-    c_rdb_d = f_rdb_d[cur_addr_d[AW-1 -: BankBits]] && !do_rd;
+    // The bank (c_bank) is the request's while one is served (its address does not
+    // change then), else the waiting request's (p_bank_q; it matters only if that one is
+    // taken now): flip-flops only, not the accept logic.
+    c_rcd_d = f_rcd_d[c_bank] && !do_act;
+    c_rc_d  = f_rc_d[c_bank] && !do_act;
+    c_ras_d = f_ras_d[c_bank] && !do_act;
+    c_rp_d  = f_rp_d[c_bank] && !do_pre;
+    c_wr_d  = f_wr_d[c_bank] && !(do_wr || do_wr2);
+    c_rdb_d = f_rdb_d[c_bank] && !do_rd;
   end
+
+  // The waiting request's compare (registered; see p_ok_q above). The bank state changes
+  // only with a PRECHARGE or an ACT (the request's own, or the refresh's PRECHARGE ALL in
+  // SRefPre); a compare made in such a clock is not used.
+  assign p_ok_d = (rd_req_valid_i || wr_valid_i) && !take_rd && !take_wr &&
+                  !do_pre && !do_act && state_q != SRefPre;
+  always_ff @(posedge clk_i) begin
+    if (rst_q) begin
+      p_ok_q   <= 1'b0;
+      p_rd_q   <= 1'b0;
+      p_hit_q  <= 1'b0;
+      p_idle_q <= 1'b0;
+      p_bank_q <= '0;
+    end else begin
+      p_ok_q   <= p_ok_d;
+      p_rd_q   <= rd_req_valid_i;
+      p_hit_q  <= open_q[new_bank] && (row_q[new_bank] == new_row);
+      p_idle_q <= !open_q[new_bank];
+      p_bank_q <= new_bank;
+    end
+  end
+
+`ifdef VERILATOR
+  // The ports' contract: a request waits on its port, unchanged, until it is taken.
+  logic [AW-1:0] p_addr_q;
+  always_ff @(posedge clk_i) begin
+    p_addr_q <= rd_req_valid_i ? rd_req_addr_i : wr_addr_i;
+    if (!rst_q && p_ok_q && (p_rd_q ? !rd_req_valid_i : !wr_valid_i))
+      $fatal(1, "de_sdram_ctrl: a waiting %s request was withdrawn",
+             p_rd_q ? "read" : "write");
+    if (!rst_q && p_ok_q && (p_rd_q ? rd_req_addr_i : wr_addr_i) != p_addr_q)
+      $fatal(1, "de_sdram_ctrl: a waiting request's address changed");
+  end
+`endif
 
   // ---------------------------------------------------------------- read data
   always_comb begin
@@ -503,13 +560,13 @@ module de_sdram_ctrl #(
 
   // ---------------------------------------------------------------- registers
   always_ff @(posedge clk_i) begin
-    if (rst_i) all_pre_ok_q <= 1'b0;
+    if (rst_q) all_pre_ok_q <= 1'b0;
     else       all_pre_ok_q <= all_pre_ok &&
                                ((state_q == SRun && !cur_valid_q) || state_q == SRefPre);
   end
 
   always_ff @(posedge clk_i) begin
-    if (rst_i) begin
+    if (rst_q) begin
       state_q     <= SInitWait;
       wait_q      <= 20'(NInit);
       init_ref_q  <= 1'b0;

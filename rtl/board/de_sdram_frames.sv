@@ -527,7 +527,10 @@ module de_sdram_frames #(
   // selects it; the hold is reloaded a clock later at the soonest), so the arbiter is
   // not in front of the RAM's write port; and a head register, reloaded in the clock after a
   // burst's last word (the next burst's first word comes 2 clocks after it at the
-  // soonest; a burst's first word comes 8 clocks after its grant at the soonest).
+  // soonest; a burst's first word comes 8 clocks after its grant at the soonest). The
+  // head's per-word masks are shift registers (vm_q, lm_q) that move on with each word,
+  // so bit 0 is the word on the controller's output now: no word index, no multiplexer
+  // in front of the return path's flags.
   localparam int unsigned InfoDepth = 8;
   typedef struct packed {
     logic       tbl;
@@ -540,9 +543,11 @@ module de_sdram_frames #(
   info_t       info_mem_q [InfoDepth];
   logic [2:0]  info_wp_q, info_rp_q;
   logic [3:0]  info_cnt_q, info_cnt_d;
-  info_t       head_q, info_new;
+  info_t       info_new, info_rd;
+  logic        h_tbl_q, h_comp_q;   // the head: what the burst is
+  logic [2:0]  h_win_q;
   logic        head_v_q, info_push, info_push_q, head_load;
-  logic [1:0]  widx_q;
+  logic [3:0]  vm_q, lm_q;          // the head's vmask / lmask, shifted one per word
 
   always_comb begin
     info_new = '0;
@@ -560,9 +565,20 @@ module de_sdram_frames #(
   // are the output register, the controller's request and the bursts coming back).
   assign info_room_d = info_cnt_q <= 4'(InfoDepth - 5);
 
+  assign info_rd = info_mem_q[info_rp_q];
   always_ff @(posedge clk_sdram_i) begin
     if (info_push_q) info_mem_q[info_wp_q] <= info_new;
-    if (head_load)   head_q <= info_mem_q[info_rp_q];
+    // A word never comes in the clock the head is loaded (checked below).
+    if (head_load) begin
+      h_tbl_q  <= info_rd.tbl;
+      h_win_q  <= info_rd.win;
+      h_comp_q <= info_rd.comp;
+      vm_q     <= info_rd.vmask;
+      lm_q     <= info_rd.lmask;
+    end else if (ctl_rd_valid) begin
+      vm_q <= vm_q >> 1;
+      lm_q <= lm_q >> 1;
+    end
   end
   always_ff @(posedge clk_sdram_i) begin
     if (rst_sd) begin
@@ -571,7 +587,6 @@ module de_sdram_frames #(
       info_rp_q   <= '0;
       info_cnt_q  <= '0;
       head_v_q    <= 1'b0;
-      widx_q      <= 2'd0;
     end else begin
       info_push_q <= info_push;
       if (info_push_q) info_wp_q <= info_wp_q + 3'd1;
@@ -579,7 +594,6 @@ module de_sdram_frames #(
       info_cnt_q  <= info_cnt_d;
       if (head_load)                        head_v_q <= 1'b1;
       else if (ctl_rd_valid && ctl_rd_last) head_v_q <= 1'b0;
-      if (ctl_rd_valid) widx_q <= widx_q + 2'd1;
     end
   end
 
@@ -619,14 +633,14 @@ module de_sdram_frames #(
   logic       w_v, w_l, w_mk;
   logic [NumCh-1:0] mal_line_q, malformed, drop_q, mal_q;
   logic [NumCh-1:0][CW-1:0] drop_cnt_q, drop_cnt_d;
-  assign w_v  = head_q.vmask[widx_q];
-  assign w_l  = head_q.lmask[widx_q];
+  assign w_v  = vm_q[0];
+  assign w_l  = lm_q[0];
   assign w_mk = (ctl_rd_data[31:27] == 5'd1);
 
   for (genvar c = 0; c < NumCh; c++) begin : g_ret
     logic hit, blk, drop;
     assign hit  = ctl_rd_valid && ctl_rd_tag == 2'(c);
-    assign blk  = hit && !head_q.tbl && w_v;
+    assign blk  = hit && !h_tbl_q && w_v;
     assign drop = blk && !w_l && w_mk;
     assign malformed[c] = blk && w_l && (mal_line_q[c] || !w_mk);
     assign drop_cnt_d[c] = drop_cnt_q[c] + CW'(drop_q[c]);
@@ -641,7 +655,7 @@ module de_sdram_frames #(
         drop_cnt_q[c]  <= '0;
         drop_gray_q[c] <= '0;
       end else begin
-        ent_push_q[c] <= hit && head_q.tbl;
+        ent_push_q[c] <= hit && h_tbl_q;
         pf_push_q[c]  <= (blk && (w_l || !w_mk)) || pad_go[c];
         if (blk && w_l)  mal_line_q[c] <= 1'b0;
         else if (drop)   mal_line_q[c] <= 1'b1;
@@ -655,7 +669,7 @@ module de_sdram_frames #(
       if (pad_go[c])
         pf_wdata_q[c] <= {h_q[c].comp, h_q[c].win, MarkerWord};
       else
-        pf_wdata_q[c] <= {head_q.comp, head_q.win, (w_l && !w_mk) ? MarkerWord : ctl_rd_data};
+        pf_wdata_q[c] <= {h_comp_q, h_win_q, (w_l && !w_mk) ? MarkerWord : ctl_rd_data};
     end
 
 `ifdef VERILATOR

@@ -12,11 +12,17 @@
 //       clk_uart_i starts the transmitter with it and flips tx_ack once the transmitter
 //       has taken it; tx_ready_o returns when clk_i sees tx_ack equal tx_req.
 // rst_i (clk_i domain) reaches the UART clock through a two-flip-flop synchroniser.
+//
+// The bit period of both halves is ClkHz / Baud rounded to an integer number of clocks
+// (de_uart_pkg); elaboration fails unless it is within 2 % of the exact period
+// (docs/board.md §3.1: de_uart_rx samples each bit once, at its middle).
 `default_nettype none
 
 module de_uart_link #(
   parameter int unsigned ClkHz = 78_125_000,   // clk_uart_i
-  parameter int unsigned Baud  = 3_000_000
+  parameter int unsigned Baud  = 3_000_000,
+  localparam int unsigned ClkPerBit = de_uart_pkg::clk_per_bit(ClkHz, Baud),
+  localparam longint unsigned ErrPm = de_uart_pkg::err_permille(ClkHz, Baud)
 ) (
   input  logic       clk_i,
   input  logic       rst_i,
@@ -31,6 +37,14 @@ module de_uart_link #(
   output logic       tx_ready_o,
   input  logic [7:0] tx_data_i
 );
+  if (Baud == 0 || ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
+    $fatal(1, "de_uart_link: ClkHz / Baud must give 4..65535 clocks per bit");
+  end
+  if (ErrPm >= 20) begin : g_bad_rate
+    $fatal(1, "de_uart_link: the integer bit period ClkHz/Baud is off by 2 %% or more, ",
+           "so mid-bit sampling would drift out of the bit within one 8N1 frame");
+  end
+
   // Loader-domain TX request: the byte held while its toggle crosses (declared first:
   // both domains use them).
   logic       tx_req_q;
@@ -45,7 +59,7 @@ module de_uart_link #(
   logic       u_valid, u_ferr, u_tx_ready;
   logic [7:0] u_data;
 
-  de_uart_rx #(.ClkHz(ClkHz), .Baud(Baud)) u_rx (
+  de_uart_rx #(.ClkPerBit(ClkPerBit)) u_rx (
     .clk_i(clk_uart_i), .rst_i(urst), .rx_i,
     .valid_o(u_valid), .frame_err_o(u_ferr), .data_o(u_data)
   );
@@ -76,7 +90,7 @@ module de_uart_link #(
     end
   end
 
-  de_uart_tx #(.ClkHz(ClkHz), .Baud(Baud)) u_tx (
+  de_uart_tx #(.ClkPerBit(ClkPerBit)) u_tx (
     .clk_i(clk_uart_i), .rst_i(urst), .valid_i(u_tx_valid), .ready_o(u_tx_ready),
     .data_i(tx_hold_q), .tx_o
   );

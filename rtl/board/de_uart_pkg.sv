@@ -1,6 +1,6 @@
 // The UART's bit period (docs/board.md §3): clocks per bit, rounded to nearest, and its
-// error against ClkHz / Baud in per mille; de_uart_rx and de_uart_tx refuse to elaborate
-// at 20 per mille (2 %) or more.
+// error against ClkHz / Baud in per mille; de_uart_link refuses to elaborate at 20 per
+// mille (2 %) or more and gives its receiver and transmitter the clocks per bit.
 package de_uart_pkg;
   function automatic int unsigned clk_per_bit(int unsigned clk_hz, int unsigned baud);
     return (clk_hz + baud / 2) / baud;

@@ -1,10 +1,10 @@
 // UART receiver of the board top (8N1, LSB first), docs/board.md §3.
 //
-// The bit period is ClkHz / Baud rounded to an integer number of clocks; elaboration
-// fails unless that divider is within 2 % of the exact period, because the receiver
-// samples every bit once, at its middle, and an 8N1 frame tolerates about 5 % of total
-// rate mismatch between the two ends (half a bit over 9.5 bits), which the host's own
-// baud-rate error must share.
+// The bit period is ClkPerBit clocks; de_uart_link derives it from its clock and baud
+// rate and refuses to elaborate unless it is within 2 % of the exact period, because the
+// receiver samples every bit once, at its middle, and an 8N1 frame tolerates about 5 % of
+// total rate mismatch between the two ends (half a bit over 9.5 bits), which the host's
+// own baud-rate error must share.
 //
 // The line is synchronised by two flip-flops. A falling edge starts a start bit; if the
 // line returns to 1 at any clock of the start bit's first half, it was a glitch and the
@@ -16,10 +16,7 @@
 `default_nettype none
 
 module de_uart_rx #(
-  parameter int unsigned ClkHz = 78_125_000,
-  parameter int unsigned Baud  = 3_000_000,
-  localparam int unsigned ClkPerBit = de_uart_pkg::clk_per_bit(ClkHz, Baud),
-  localparam longint unsigned ErrPm = de_uart_pkg::err_permille(ClkHz, Baud)
+  parameter int unsigned ClkPerBit = 26  // 78.125 MHz / 3 Mbaud (de_uart_link)
 ) (
   input  logic       clk_i,
   input  logic       rst_i,
@@ -28,12 +25,8 @@ module de_uart_rx #(
   output logic       frame_err_o,  // one clock per framing error
   output logic [7:0] data_o
 );
-  if (Baud == 0 || ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
-    $fatal(1, "de_uart_rx: ClkHz / Baud must give 4..65535 clocks per bit");
-  end
-  if (ErrPm >= 20) begin : g_bad_rate
-    $fatal(1, "de_uart_rx: the integer bit period ClkHz/Baud is off by 2 %% or more, ",
-           "so mid-bit sampling would drift out of the bit within one 8N1 frame");
+  if (ClkPerBit < 4 || ClkPerBit > 65535) begin : g_bad_div
+    $fatal(1, "de_uart_rx: ClkPerBit must be 4..65535 (half a bit to reject a glitch)");
   end
 
   typedef enum logic [2:0] {SIdle, SStart, SData, SStop, SBreak} state_e;

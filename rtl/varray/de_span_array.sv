@@ -136,6 +136,8 @@ module de_span_array
     logic          accm;
     logic [3:0]    nslot;
     logic [CW-1:0] cend;       // the walk's end, worked out when the pass is written
+    logic [CW-1:0] cnx;        // the walk's second column: X + its step
+    logic          one;        // the first column is the last (X + step >= cend)
     logic          nul;        // the pass touches no column
   } hdr_t;
   hdr_t  hdr_mem [NPass];
@@ -159,6 +161,7 @@ module de_span_array
 
   logic is_dat, closer, full_d, full_q, pend_d, pend_q, commit, take, slot_we, ref_we;
   hdr_t hdr_w;
+  logic x_dx_ge_n;
   assign is_dat = !id.addr && !id.refresh && (id.data || id.acc);
   assign closer = !is_dat;
   // Registered from the next state: the ready decision reads them straight from flops.
@@ -184,9 +187,16 @@ module de_span_array
     hdr_w.nslot = nslot_q;
     // The end of the walk and the empty pass, from the group's registers: the table read
     // in front of the issue (the prefetch register) then does no arithmetic.
-    hdr_w.cend  = (per_q || CW'(x_q) + CW'(dx_q) >= CW'(NumCols)) ? CW'(NumCols)
-                                                                  : CW'(x_q) + CW'(dx_q);
+    x_dx_ge_n   = (CW'(x_q) + CW'(dx_q) >= CW'(NumCols));
+    hdr_w.cend  = (per_q || x_dx_ge_n) ? CW'(NumCols) : CW'(x_q) + CW'(dx_q);
     hdr_w.nul   = (CW'(x_q) >= hdr_w.cend);
+    // The issue keeps "this column is the last" in a register a column ahead; here are
+    // its first values. Periodic: step dX (dX = 0: 4096, past any column), end N. Range:
+    // step 1, end min(X + dX, N), so X + 1 >= end exactly when dX <= 1 or X >= N - 1;
+    // neither form waits for the cend mux above.
+    hdr_w.cnx   = CW'(x_q) + (per_q ? ((dx_q == '0) ? CW'(4096) : CW'(dx_q)) : CW'(1));
+    hdr_w.one   = per_q ? ((dx_q == '0) || x_dx_ge_n)
+                        : ((dx_q <= 12'd1) || (CW'(x_q) >= CW'(NumCols - 1)));
     if (ref_we) begin
       hdr_w       = '0;
       hdr_w.rfr   = 1'b1;
@@ -248,11 +258,33 @@ module de_span_array
   // One memory per slot position: one write port (the front end) and one read port,
   // which is what maps onto distributed RAM. It is read for the token one stage ahead
   // and registered, so no RAM read sits in front of a stage's adder.
+  // The write is registered first (a clock late): the accept decision in front of it,
+  // decoded from the incoming identifier, otherwise ran on into the write enables of all
+  // K memories. A slot is read only after its pass is committed (a clock after the slot
+  // at the earliest), seen by the issue a clock later and walked after that, so the late
+  // write is always in place before the first read.
+  logic          sw_we_q;
+  logic [3:0]    sw_j_q;
+  logic [PW-1:0] sw_ptr_q;
+  slot_t         sw_data_q;
+  always_ff @(posedge clk_i) begin
+    if (rst_i) begin
+      sw_we_q <= 1'b0;
+    end else begin
+      sw_we_q <= slot_we;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    sw_j_q    <= nslot_q;
+    sw_ptr_q  <= wr_ptr;
+    sw_data_q <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
+  end
+
   for (genvar j = 0; j < K; j++) begin : g_slot_mem
     (* ram_style = "distributed" *) slot_t mem [NPass];
     always_ff @(posedge clk_i) begin
-      if (slot_we && (nslot_q == 4'(j))) begin
-        mem[wr_ptr] <= slot_t'({id.acc, id.dst, id.src, id.set, id.prot, data_i});
+      if (sw_we_q && (sw_j_q == 4'(j))) begin
+        mem[sw_ptr_q] <= sw_data_q;
       end
       slot_q[j] <= mem[tok_q[j + 1].ptr];
     end
@@ -263,14 +295,25 @@ module de_span_array
   logic          bank_d, bank_q;      // the bank the engine works on (this line's)
   logic          drain_busy;
   logic [CW-1:0] col_d, col_q, end_d, end_q, step_d, step_q;
+  // col + step (the next column) and "col + step >= end" (this column is the pass's
+  // last), kept a column ahead: the last-token decision, which decides whether the next
+  // pass goes in this clock, then starts at a flip-flop instead of an adder and a
+  // compare (the core clock's worst path on the board).
+  logic [CW-1:0] cnx_d, cnx_q;
+  logic          last_d, last_q;
   tok_t          cur_d, cur_q;        // the running pass's token template
   tok_t          iss;                 // token issued this clock (vld = 0: none)
-  logic          hazard;
+  logic          hazard;              // the stall test as written (checked against hz_q)
+  // The stall test a clock ahead (hz_q): for each column the walk can be at next clock
+  // (the same, the next, or the next pass's first), against the tokens that will then be
+  // in the first HzStages stages. The walk then reads the test from a flip-flop.
+  logic          hz_d, hz_q, hz_stay, hz_adv, hz_new, adv;
   // The next pass, decoded a clock ahead from the pass table (entry ld_cnt): its token
   // template and column range. It goes into the issue registers when the engine is idle,
   // or (Prefetch) in the clock the running pass issues its last token.
   tok_t          nxt_d, nxt_q;
-  logic [CW-1:0] ncol_d, ncol_q, nend_d, nend_q, nstep_d, nstep_q;
+  logic [CW-1:0] ncol_d, ncol_q, nend_d, nend_q, nstep_d, nstep_q, ncnx_d, ncnx_q;
+  logic          nlast_d, nlast_q;
   logic          nvld_d, nvld_q, fin, xfer;
   logic [PW:0]   ld_cnt_d, ld_cnt_q;
   // With forwarding a token waits only while an earlier token of its column is in the
@@ -287,6 +330,22 @@ module de_span_array
     end
   end
 
+  // Next clock, stage s + 1 holds today's stage s, and stage 0 today's issued token. That
+  // token is at col_q, which only the next pass can meet again: a pass's columns rise.
+  always_comb begin
+    hz_stay = 1'b0;
+    hz_adv  = 1'b0;
+    hz_new  = iss.vld && !iss.nul && (col_q == ncol_q);
+    for (int s = 0; s + 1 < HzStages; s++) begin
+      if (tok_q[s].vld && !tok_q[s].nul) begin
+        if (tok_q[s].col == col_q) hz_stay = 1'b1;
+        if (tok_q[s].col == cnx_q) hz_adv = 1'b1;
+        if (tok_q[s].col == ncol_q) hz_new = 1'b1;
+      end
+    end
+    hz_d = xfer ? hz_new : adv ? hz_adv : hz_stay;
+  end
+
   hdr_t hr;
   assign hr = hdr_mem[ld_cnt_q[PW-1:0]];
 
@@ -296,6 +355,8 @@ module de_span_array
     ncol_d   = ncol_q;
     nend_d   = nend_q;
     nstep_d  = nstep_q;
+    ncnx_d   = ncnx_q;
+    nlast_d  = nlast_q;
     nvld_d   = nvld_q && !xfer;
     ld_cnt_d = ld_cnt_q;
     if ((!nvld_q || xfer) && (ld_cnt_q != wr_cnt_q)) begin
@@ -309,10 +370,14 @@ module de_span_array
       nxt_d.i12   = hr.i12;
       nxt_d.accm  = hr.accm;
       nxt_d.nslot = hr.nslot;
+      ncnx_d      = hr.cnx;
+      nlast_d     = hr.one;
       if (hr.rfr) begin
         ncol_d  = '0;
         nend_d  = '0;
         nstep_d = CW'(1);
+        ncnx_d  = CW'(1);
+        nlast_d = 1'b1;
       end else if (hr.per) begin
         // Period dX; dX = 0 reloads the countdown with 4095: period 4096 (isa.md 5).
         ncol_d  = CW'(hr.x);
@@ -336,13 +401,16 @@ module de_span_array
     col_d     = col_q;
     end_d     = end_q;
     step_d    = step_q;
+    cnx_d     = cnx_q;
+    last_d    = last_q;
     cur_d     = cur_q;
+    adv       = 1'b0;
     iss_cnt_d = iss_cnt_q;
     iss       = cur_q;
     iss.vld   = 1'b0;
     iss.col   = col_q;
     iss.bank  = bank_q;
-    iss.last  = (col_q + step_q >= end_q);
+    iss.last  = last_q;
     fin       = 1'b0;
     if (scrub_q) begin
       // Reset sweep: clear every column (block RAM has no reset).
@@ -367,9 +435,14 @@ module de_span_array
         fin       = 1'b1;
       end
     end else if (run_q) begin
-      if (cur_q.nul || !hazard) begin
+      if (cur_q.nul || !hz_q) begin
         iss.vld = 1'b1;
-        col_d   = col_q + step_q;
+        adv     = 1'b1;
+        col_d   = cnx_q;
+        // cnx_q < end_q <= NumCols here whenever the walk goes on, so the sum below
+        // cannot wrap CW bits.
+        cnx_d   = cnx_q + step_q;
+        last_d  = (cnx_q + step_q >= end_q);
         cur_d.first = 1'b0;
         if (cur_q.nul || iss.last) begin
           iss.last  = 1'b1;
@@ -387,6 +460,8 @@ module de_span_array
       col_d  = ncol_q;
       end_d  = nend_q;
       step_d = nstep_q;
+      cnx_d  = ncnx_q;
+      last_d = nlast_q;
     end
   end
 
@@ -655,6 +730,9 @@ module de_span_array
       col_q     <= '0;
       end_q     <= '0;
       step_q    <= '0;
+      cnx_q     <= '0;
+      last_q    <= 1'b1;
+      hz_q      <= 1'b0;
       cur_q     <= '0;
       pixv_q    <= 1'b0;
       pix_q     <= '0;
@@ -665,6 +743,8 @@ module de_span_array
       ncol_q    <= '0;
       nend_q    <= '0;
       nstep_q   <= '0;
+      ncnx_q    <= '0;
+      nlast_q   <= 1'b1;
       fsel_q    <= 2'd0;
       fw1_q     <= 1'b0;
       for (int s = 0; s < K + 3; s++) begin
@@ -700,6 +780,9 @@ module de_span_array
       col_q     <= col_d;
       end_q     <= end_d;
       step_q    <= step_d;
+      cnx_q     <= cnx_d;
+      last_q    <= last_d;
+      hz_q      <= hz_d;
       cur_q     <= cur_d;
       pixv_q    <= pixv_d;
       pix_q     <= pix_d;
@@ -710,6 +793,8 @@ module de_span_array
       ncol_q    <= ncol_d;
       nend_q    <= nend_d;
       nstep_q   <= nstep_d;
+      ncnx_q    <= ncnx_d;
+      nlast_q   <= nlast_d;
       fsel_q    <= fsel_d;
       fw1_q     <= wb_we;
       tok_q[0]  <= iss;
@@ -740,6 +825,21 @@ module de_span_array
   assign pix_col_o     = pixc_q;
   assign busy_o        = scrub_q || run_q || drain_busy || (wr_cnt_q != ret_cnt_q) ||
                          (iss_cnt_q != wr_cnt_q);
+
+`ifdef VERILATOR
+  // The walk's look-ahead registers against the sums they stand for (checked in every
+  // simulation: a wrong update would otherwise show only as a pass ended early or late).
+  always_ff @(posedge clk_i) begin
+    if (!rst_i && run_q && !cur_q.rfr &&
+        (cnx_q != col_q + step_q || last_q != (col_q + step_q >= end_q)))
+      $fatal(1, "de_span_array: walk look-ahead out of step at column %0d", col_q);
+    if (!rst_i && run_q && !cur_q.rfr && !cur_q.nul && hz_q != hazard)
+      $fatal(1, "de_span_array: stall test a clock ahead (%0d) differs at column %0d",
+             hz_q, col_q);
+    if (!rst_i && commit && !ref_we && hdr_w.one != (hdr_w.cnx >= hdr_w.cend))
+      $fatal(1, "de_span_array: first-column-is-last flag wrong for X %0d", x_q);
+  end
+`endif
 
 endmodule
 

@@ -108,13 +108,14 @@ def make_frames(rng: random.Random, va: int):
 try:
     import cocotb
     from cocotb.clock import Clock
-    from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, Timer
+    from cocotb.triggers import ClockCycles, FallingEdge, Timer
 except ImportError:  # pytest collection without cocotb's simulator
     cocotb = None
 
 if cocotb is not None:
     @cocotb.test()
     async def test_frames(dut):
+        from common.run import offer
         seed = int(os.environ.get("SEED", random.randrange(1 << 30)))
         rng = random.Random(seed)
         pix_ps = int(os.environ.get("PIX_PS", "40000"))
@@ -156,18 +157,9 @@ if cocotb is not None:
         cocotb.start_soon(player())
 
         async def send(cmd: int):
-            """Valid from a falling edge; ready (combinational) is looked at once the
-            inputs have settled, and the rising edge after it takes the command."""
+            """Valid from a falling edge until the command is taken (common.run.offer)."""
             await FallingEdge(dut.clk_i)
-            dut.cmd_i.value = cmd
-            dut.cmd_valid_i.value = 1
-            while True:
-                await ReadOnly()
-                ok = int(dut.cmd_ready_o.value)
-                await FallingEdge(dut.clk_i)
-                if ok:
-                    break
-            dut.cmd_valid_i.value = 0
+            await offer(dut, "cmd_valid_i", "cmd_ready_o", cmd_i=cmd)
 
         # Writes interleaved between colours, in random order of runs.
         all_w = [(c, o, w) for c in range(NCH) for (o, w) in writes[c]]

@@ -84,6 +84,22 @@ def drive(dut, **values) -> None:
         getattr(dut, name).value = value
 
 
+async def offer(dut, valid: str, ready: str, **values) -> None:
+    """One valid/ready handshake on clk_i, from the falling edge the caller stands on:
+    drive the values (name=value) with `valid` high, look at `ready` once the inputs have
+    settled (ReadOnly: ready may be combinational), and return at the falling edge after
+    the rising edge that took them, with `valid` low again."""
+    from cocotb.triggers import FallingEdge, ReadOnly
+    drive(dut, **{valid: 1}, **values)
+    while True:
+        await ReadOnly()
+        taken = int(getattr(dut, ready).value)
+        await FallingEdge(dut.clk_i)
+        if taken:
+            break
+    getattr(dut, valid).value = 0
+
+
 async def hold_reset(dut, rises: int, *, falling: bool = True, clock_ns: float | None = None,
                      **inputs) -> None:
     """The testbenches' reset: optionally start a clock_ns clock on clk_i, raise rst_i

@@ -4,8 +4,10 @@ Toplevel tb_sdram_ctrl.sv: the controller drives sim/models/sdram_sdr16.sv over 
 SDRAM pins; the model counts every timing or protocol violation (err_count_o).
 Structure:
   Driver   - per clock (falling edge) offers at most one read request (4 words) and one
-             write (1 word); a request counts as taken when ready was high (ready does
-             not depend on valid, so it is read before driving).
+             write (1 word), each kept on its port until taken (the controller's
+             contract; it stops the simulation otherwise); a request counts as taken
+             when its port's ready was high (the readies depend on flip-flops only, not
+             on valid, so they are read before driving).
   Monitor  - samples rd_valid_o / rd_data_o / rd_tag_o once per clock.
   Model    - a dict word address -> 32-bit word, updated in acceptance order (the
              controller serves requests in order), and the queue of expected read words.
@@ -16,6 +18,9 @@ Builds: 125 MHz with CL 3 (the board's), 100 MHz with CL 2; power-up wait shorte
 to 2 us. Tests:
   random_rw   - random writes and 4-word reads over a few rows of every bank (hits,
                 misses, bank conflicts), reads verified against the dict;
+  waiting_request - reads and writes of two rows of one bank back to back, each waiting
+                at its port while the one before changes the bank's open row (the
+                controller's open-row compare of a waiting request must be current);
   stream      - three "colours", each streaming its own bank sequentially (rows change
                 every 256 words), for > 20 refresh intervals: data verified, 0 timing
                 violations, REF count as due, and the sustained read bandwidth printed.
@@ -90,7 +95,9 @@ class Bench:
         await FallingEdge(dut.clk_i)
         self.cycle += 1
         self.monitor()
-        ready = int(dut.rd_req_ready_o.value)
+        rd_ready = int(dut.rd_req_ready_o.value)
+        wr_ready = int(dut.wr_ready_o.value)
+        assert not (rd_ready and wr_ready), f"cycle {self.cycle}: both ports ready"
         took_rd = took_wr = False
         dut.rd_req_valid_i.value = int(rd is not None)
         dut.wr_valid_i.value = int(wr is not None)
@@ -98,7 +105,7 @@ class Bench:
             addr, tag = rd
             dut.rd_req_addr_i.value = addr
             dut.rd_req_tag_i.value = tag
-            if ready:
+            if rd_ready:
                 took_rd = True
                 base = addr & ~3
                 for i in range(4):
@@ -107,7 +114,7 @@ class Bench:
             addr, word = wr
             dut.wr_addr_i.value = addr
             dut.wr_data_i.value = word
-            if ready and rd is None:
+            if wr_ready:
                 took_wr = True
                 self.mem[addr] = word
         return took_rd, took_wr
@@ -145,10 +152,11 @@ async def random_rw(dut):
     n_ops = int(os.environ.get("SDRAM_CTRL_OPS", "600"))
     pend_rd = pend_wr = None
     done = 0
-    while done < n_ops:
-        if pend_rd is None and rng.random() < 0.4:
+    # A request stays on its port until it is taken (the controller checks that).
+    while done < n_ops or pend_rd is not None or pend_wr is not None:
+        if pend_rd is None and done < n_ops and rng.random() < 0.4:
             pend_rd = (rand_addr() & ~3, rng.randrange(4))
-        if pend_wr is None and rng.random() < 0.6:
+        if pend_wr is None and done < n_ops and rng.random() < 0.6:
             pend_wr = (rand_addr(), rng.randrange(1 << 32))
         took_rd, took_wr = await b.clock(pend_rd, pend_wr)
         if took_rd:
@@ -158,6 +166,63 @@ async def random_rw(dut):
     await b.drain()
     dut._log.info("random_rw SEED=%d: %d requests, %d words read, %d clocks, %d REFs, "
                   "0 violations", s, n_ops, b.words, b.cycle, int(dut.ref_count_o.value))
+
+
+@cocotb.test() if cocotb else (lambda f: f)
+async def waiting_request(dut):
+    """A request waits at its port while the one before it changes the rows of its bank:
+    the controller must use an open-row compare made after that change, not the one of
+    the clock the request arrived. Per round, in one bank, rows X and A hold different
+    words: read X (X open), read A (a miss: PRECHARGE, ACT) with the next read of X put
+    on the port in the clock A is taken, while X is still open (a compare kept from then
+    says "row open" and reads row A's words), then writes and reads of both rows back to
+    back, a write waiting beside a read; every word checked, 0 violations."""
+    s = seed()
+    rng = random.Random(s)
+    b = Bench(dut, rng)
+    await b.start()
+    rounds = int(os.environ.get("SDRAM_CTRL_ROUNDS", "40"))
+    for r in range(rounds):
+        bank = r % 4
+        row_x, row_a = rng.sample(range(8192), 2)
+        col = rng.randrange(64) * 4
+        for row in (row_x, row_a):
+            for i in range(4):
+                wr = (addr_of(bank, row, col + i), rng.randrange(1 << 32))
+                while not (await b.clock(None, wr))[1]:
+                    pass
+        # Back to back, each put on its port in the clock after the one before is taken.
+        ops = [("r", row_x), ("r", row_a), ("r", row_x), ("w", row_a), ("r", row_x),
+               ("r", row_a), ("w", row_x), ("r", row_x), ("r", row_a)]
+        rng.shuffle(ops[3:])
+        ops = [(op, addr_of(bank, row, col + rng.randrange(4) if op == "w" else col))
+               for op, row in ops]
+        i = 0
+        side = None
+        word = rng.randrange(1 << 32)
+        while i < len(ops):
+            op, addr = ops[i]
+            rd = (addr, bank) if op == "r" else None
+            wr = (addr, word) if op == "w" else None
+            # Now and then the read after a write waits beside it from the write's first
+            # clock on (a request stays on its port until taken); either may go first.
+            if (op == "w" and side is None and i + 1 < len(ops) and ops[i + 1][0] == "r"
+                    and rng.random() < 0.5):
+                side = (ops[i + 1][1], bank)
+            took_rd, took_wr = await b.clock(rd or side, wr)
+            if op == "w" and took_rd:                # the side read went first
+                ops.pop(i + 1)
+                side = None
+            elif (op == "r" and took_rd) or (op == "w" and took_wr):
+                i += 1
+                word = rng.randrange(1 << 32)
+                if side is not None:                 # the side read is now the head
+                    side = None
+        if r % 8 == 7:
+            await b.drain()
+    await b.drain()
+    dut._log.info("waiting_request SEED=%d: %d rounds, %d words read, %d clocks, "
+                  "0 violations", s, rounds, b.words, b.cycle)
 
 
 @cocotb.test() if cocotb else (lambda f: f)
@@ -183,7 +248,8 @@ async def stream(dut):
     b.words, b.first_word = 0, None
     start = b.cycle
     req = None
-    while b.cycle - start < cycles:
+    # The window's last request is kept on the port until it is taken.
+    while b.cycle - start < cycles or req is not None:
         if req is None:
             req = (addr_of(c, 100 + c, 0) + pos[c], c)
         took, _ = await b.clock(req, None)

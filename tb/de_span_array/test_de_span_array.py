@@ -59,17 +59,8 @@ class Bench:
     async def offer(self, ident: int, data: int):
         """Hold one slot on the port until the array takes it (ready in the same clock);
         returns at the falling edge after the clock that took it."""
-        d = self.dut
-        d.instr_valid_i.value = 1
-        d.id_i.value = ident
-        d.data_i.value = data
-        while True:
-            await ReadOnly()
-            taken = int(d.instr_ready_o.value)
-            await FallingEdge(d.clk_i)
-            if taken:
-                break
-        d.instr_valid_i.value = 0
+        from common.run import offer
+        await offer(self.dut, "instr_valid_i", "instr_ready_o", id_i=ident, data_i=data)
 
     async def play(self, slots, gap: int = 0):
         """Offer each slot until the array takes it, with random idle clocks between
