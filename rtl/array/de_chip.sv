@@ -122,6 +122,8 @@ module de_chip_core
   // register makes its own from link_o (so that the chip's ports stay link_t).
   /* verilator lint_off UNUSEDSIGNAL */
   logic [NumPe:0]            bus_blk1z;
+  // Timing only: a second copy of bus_id for the next PE's operand selects (de_pe IdCopy).
+  logic [NumPe:0][IdW-1:0]   bus_idsel;
   /* verilator lint_on UNUSEDSIGNAL */
   logic [NumPe:0][PixW-1:0]  pix_or;
   logic [NumPe:0]            pixv_or;
@@ -136,6 +138,7 @@ module de_chip_core
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
   assign bus_id[0]   = link_i.id;
+  assign bus_idsel[0] = link_i.id;
   assign bus_data[0] = link_i.data;
   assign bus_blk1z[0] = blk1z_i;
   assign pix_or[0]   = link_i.pix_valid ? link_i.pix : '0;
@@ -159,7 +162,9 @@ module de_chip_core
     end
     assign rst_loc[i] = rst_i[(5 * i + 4) % RstW];
 
-    de_pe #(.CarryBug(CarryBug), .Compact(Compact), .RstW(PeRstW)) u_pe (
+    logic [IdW-1:0]   pe_idsel;
+    de_pe #(.CarryBug(CarryBug), .Compact(Compact), .RstW(PeRstW),
+            .IdCopy((Compact == 1) ? 0 : 1)) u_pe (
       .clk_i,
       .rst_i      (pe_rst[i]),
       .bypass_i   (pe_byp[i]),
@@ -167,9 +172,11 @@ module de_chip_core
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .blk1z_i    (bus_blk1z[i]),
+      .idsel_i    (bus_idsel[i]),
       .id_o       (pe_id),
       .data_o     (pe_data),
       .blk1z_o    (pe_blk1z),
+      .idsel_o    (pe_idsel),
       .pix_valid_o(pe_pixv),
       .pix_o      (pe_pix),
       .dbg_o      (pe_dbg)
@@ -194,6 +201,7 @@ module de_chip_core
       end
     end
     assign bus_id[i+1]   = pe_id;
+    assign bus_idsel[i+1] = pe_idsel;
     assign bus_data[i+1] = (FaultMask[i] && !byp_q[i]) ? ~pe_data : pe_data;
     // The garbled block is zero where the PE's was all ones (test only; with no fault
     // this is the PE's flip-flop).

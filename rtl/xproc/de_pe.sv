@@ -25,7 +25,11 @@ module de_pe
   // Timing only: how many copies of the reset (and of the bypass bit) the PE takes, 1..4.
   // Register group g (RstBus, RstAb, RstCd, RstCtl below) reads copy g % RstW, so that no
   // copy drives more than about 90 flip-flops (docs/xproc.md section 8).
-  parameter int unsigned RstW = 1
+  parameter int unsigned RstW = 1,
+  // Timing only: 1 = the stage-0 operand selects read idsel_i, a second copy of the
+  // previous PE's identifier register, so that they do not wait on id_i's fan-out to the
+  // whole decode (docs/fpga.md section 6.3, fourth pass); 0 = they read id_i.
+  parameter int unsigned IdCopy = 0
 ) (
   input  logic             clk_i,
   // Synchronous, active high. RstW copies of ONE reset, equal in every cycle (registered
@@ -46,9 +50,14 @@ module de_pe
   // Timing only: data_i's block 1 is zero, registered by the sender beside its data_o
   // (the previous PE's blk1z_o, or a register in front of PE 0). Not architectural.
   input  logic             blk1z_i,
+  // Timing only: = id_i in every cycle (the previous PE's idsel_o), read when IdCopy = 1.
+  /* verilator lint_off UNUSEDSIGNAL */
+  input  logic [IdW-1:0]   idsel_i = '0,
+  /* verilator lint_on UNUSEDSIGNAL */
   output logic [IdW-1:0]   id_o,         // registered, to the next PE
   output logic [DataW-1:0] data_o,       // registered, to the next PE (same skew)
   output logic             blk1z_o,      // registered: data_o's block 1 is zero
+  output logic [IdW-1:0]   idsel_o,      // = id_o (a register of its own when IdCopy = 1)
   output logic             pix_valid_o,  // registered: a Refresh's pixel this cycle
   output logic [PixW-1:0]  pix_o,        // registered: D[35:24], zero when not valid
   output logic [DbgW-1:0]  dbg_o         // all state, for the testbench (unused in a chip)
@@ -174,10 +183,15 @@ module de_pe
   assign pv0     = ev0 && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
   assign prot0   = act_eff && pv0;
   assign active0 = ev0 && act_eff;
-  assign src0    = reg_blk(id0.src, a_q[0], b_q[0], c_q[0]);
+  // The operand selects read their own copy of the identifier (IdCopy; equal to id0).
+  /* verilator lint_off UNUSEDSIGNAL */
+  id_t id0s;
+  /* verilator lint_on UNUSEDSIGNAL */
+  assign id0s    = (IdCopy == 1) ? id_t'(idsel_i) : id0;
+  assign src0    = reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
   // v0 + SRC0 with v0 = prot0 ? DST0 : in0: both sums are formed while act_eff is still
   // being decided and pv0 picks one after the adders (carry select on the operand).
-  assign sp0     = {1'b0, reg_blk(id0.dst, a_q[0], b_q[0], c_q[0])} + {1'b0, src0};
+  assign sp0     = {1'b0, reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0])} + {1'b0, src0};
   assign sn0     = {1'b0, in_blk[0]} + {1'b0, src0};
   assign s0      = pv0 ? sp0 : sn0;
   // A protected slot writes DST with DST's own value: no write. So a write is in0 only.
@@ -500,13 +514,11 @@ module de_pe
 
   always_ff @(posedge clk_i) begin
     if (rst_bus) begin
-      id_q    <= '0;
       out_q   <= '0;
       blk1z_q <= 1'b1;  // out_q is zero
       per1_q  <= 1'b0;
       src1_q  <= '0;
     end else begin
-      id_q    <= id_d;
       out_q   <= out_d;
       blk1z_q <= blk1z_d;
       per1_q  <= per1_d;
@@ -599,6 +611,29 @@ module de_pe
       src2_q   <= src2_d;
       dst2_q   <= dst2_d;
     end
+  end
+
+  // The second copy of id_q for the next PE's operand selects: a kept process of its own,
+  // or yosys' opt_merge folds it into id_q (docs/fpga.md section 6.3, third pass).
+  // One kept process per bit, for id_q as for its copy: a keep on a vector's process, or
+  // on one of the two copies only, still lets opt_merge fold them into one.
+  for (genvar k = 0; k < IdW; k++) begin : g_id_bit
+    (* keep *) always_ff @(posedge clk_i) begin
+      if (rst_bus) id_q[k] <= 1'b0;
+      else         id_q[k] <= id_d[k];
+    end
+  end
+  if (IdCopy == 1) begin : g_idsel
+    logic [IdW-1:0] idsel_q;
+    for (genvar k = 0; k < IdW; k++) begin : g_bit
+      (* keep *) always_ff @(posedge clk_i) begin
+        if (rst_bus) idsel_q[k] <= 1'b0;
+        else         idsel_q[k] <= id_d[k];
+      end
+    end
+    assign idsel_o = idsel_q;
+  end else begin : g_no_idsel
+    assign idsel_o = id_q;
   end
 
   // ---- outputs ----------------------------------------------------------------------------
