@@ -628,18 +628,11 @@ def pe_loop(args) -> int:
 
 
 # ---------------------------------------------------------------------------- frames loop
-FRAMES_FILES = ["rtl/board/de_frame_fetch.sv", "rtl/board/de_frame_player.sv",
-                "rtl/board/de_sdram_frames.sv"]
-
-
 def frames_loop(args) -> int:
     """de_sdram_frames out of context, per seed: fmax per clock, the SDRAM clock's worst
     path step by step."""
     out = BUILD / "frames_ooc"
-    srcs: list[str] = []
-    for f in core_srcs("sdram_ctrl") + core_srcs("prim") + core_srcs("input") + FRAMES_FILES:
-        if f not in srcs:
-            srcs.append(f)
+    srcs = core_srcs("board", "frames")
     print("[frames] synthesis of de_sdram_frames", flush=True)
     cells = yosys("chip_ecp5.ys", out, "de_sdram_frames", srcs, {})
     print("  cells: " + ", ".join(f"{k} {count(cells, k)}" for k in CELL_KEYS["ecp5"]
