@@ -32,6 +32,7 @@ module chip_top #(
   output logic fold_o         // XOR of every chip output bit, registered
 );
   localparam int unsigned InW  = 12 + 36 + 1 + 12;             // id, data, pix_valid, pix
+  localparam int unsigned IdW  = de_pkg::IdW;                  // = 12, sh_q[11:0]
   localparam int unsigned OutW = 12 + 36 + 1 + 12 + NumPe + 1; // + bypass, collision
   localparam int unsigned Grp  = 4;                            // XOR inputs per LUT
   localparam int unsigned NGrp = (OutW + Grp - 1) / Grp;
@@ -62,10 +63,26 @@ module chip_top #(
     obs_load_q  <= obs_load_i;
     obs_shift_q <= obs_shift_i;
     obs_bit_q   <= obs_bit_i;
-    sh_q        <= {sh_q[InW-2:0], sin_i};
     // de_chip's input block 1 (sh_q[35:24]) is zero next cycle: what the upstream chip's
     // boundary register provides in an array.
     blk1z_q     <= (sh_q[34:23] == '0);
+  end
+  logic [IdW-1:0]   idsel;
+  if (Compact == 1) begin : g_in_small
+    always_ff @(posedge clk_i) sh_q <= {sh_q[InW-2:0], sin_i};
+    assign idsel = '0;   // not read: the Compact chip's PEs have no identifier copy
+  end else begin : g_in_fast
+    // The identifier bits of the shift register and a copy of them (de_chip idsel_i):
+    // what the upstream chip's boundary register and its copy provide in an array
+    // (de_chip_bound IdCopy). Each bit of both a kept process, or opt_merge folds them.
+    logic [IdW-1:0] sh_in, idsel_q;
+    assign sh_in = {sh_q[IdW-2:0], sin_i};
+    always_ff @(posedge clk_i) sh_q[InW-1:IdW] <= sh_q[InW-2:IdW-1];
+    for (genvar k = 0; k < IdW; k++) begin : g_id_bit
+      (* keep *) always_ff @(posedge clk_i) sh_q[k]    <= sh_in[k];
+      (* keep *) always_ff @(posedge clk_i) idsel_q[k] <= sh_in[k];
+    end
+    assign idsel = idsel_q;
   end
 
   de_chip #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .RstW(RstW)) u_chip (
@@ -76,6 +93,8 @@ module chip_top #(
     .link_o,
     .blk1z_i    (blk1z_q),
     .blk1z_o    (),
+    .idsel_i    (idsel),
+    .idsel_o    (),
     .chain_ctl_i({cfg_mode_q, obs_load_q, obs_shift_q}),
     .chain_i    ({cfg_bit_q, obs_bit_q}),
     .chain_o,

@@ -49,6 +49,9 @@ module de_array
   // Timing only: link_c[c].data's block 1 is zero (registered); de_deskew needs no flag.
   /* verilator lint_off UNUSEDSIGNAL */
   logic   [NumChips:0] blk1z_c;
+  // Timing only: = link_c[c].id, the previous chip's copy of its id register (de_chip
+  // idsel_o); chip 0's is link_c[0].id itself (the array input is not registered here).
+  logic   [NumChips:0][IdW-1:0] idsel_c;
   /* verilator lint_on UNUSEDSIGNAL */
   chain_t [NumChips:0] chain_c;
   logic   [NumChips-1:0] coll_c;
@@ -69,6 +72,7 @@ module de_array
     else       skew_blk1z_q <= (data_i[BlkW +: BlkW] == '0);
   end
   assign blk1z_c[0] = skew_blk1z_q;
+  assign idsel_c[0] = link_c[0].id;
 
   for (genvar c = 0; c < NumChips; c++) begin : g_chip
     de_chip #(
@@ -81,6 +85,8 @@ module de_array
       .link_o     (link_c[c+1]),
       .blk1z_i    (blk1z_c[c]),
       .blk1z_o    (blk1z_c[c+1]),
+      .idsel_i    (idsel_c[c]),
+      .idsel_o    (idsel_c[c+1]),
       .chain_ctl_i({cfg_mode_i, obs_load_i, obs_shift_i}),
       .chain_i    (chain_c[c]),
       .chain_o    (chain_c[c+1]),

@@ -46,6 +46,14 @@ module de_chip
   // boundary register, or a register beside the input skew); blk1z_o likewise for link_o.
   input  logic             blk1z_i,
   output logic             blk1z_o,
+  // Timing only: = link_i.id in every cycle, a register of its own (the previous chip's
+  // idsel_o, or at the array input link_i.id itself), which the PE 0 stage-0 operand
+  // selects read (de_pe IdCopy); idsel_o likewise for link_o.id (= link_o.id when
+  // Compact). Not architectural.
+  /* verilator lint_off UNUSEDSIGNAL */
+  input  logic [IdW-1:0]   idsel_i,
+  /* verilator lint_on UNUSEDSIGNAL */
+  output logic [IdW-1:0]   idsel_o,
   // configuration chain: shifts one bit per clock while chain_ctl_i.cfg_mode;
   // observation chain: parallel load on .obs_load, shift one bit per clock on .obs_shift
   input  chain_ctl_t       chain_ctl_i,
@@ -66,12 +74,14 @@ module de_chip
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask),
                  .RstW(RstW))
   u_core (
-    .clk_i, .rst_i, .link_i, .blk1z_i, .chain_ctl_i, .chain_i, .chain_o, .bypass_o,
-    .link_o(core_link)
+    .clk_i, .rst_i, .link_i, .blk1z_i, .idsel_i, .chain_ctl_i, .chain_i, .chain_o,
+    .bypass_o, .link_o(core_link)
   );
 
-  de_chip_bound u_bound (.clk_i, .rst_i(rst_i[(5 * NumPe + 1) % RstW]), .link_i(core_link),
-                         .link_o, .blk1z_o);
+  de_chip_bound #(.IdCopy((Compact == 1) ? 0 : 1)) u_bound (
+    .clk_i, .rst_i(rst_i[(5 * NumPe + 1) % RstW]), .link_i(core_link), .link_o, .blk1z_o,
+    .idsel_o
+  );
 endmodule
 
 // The chip without its boundary registers: bus and pixel chain from input to output
@@ -94,6 +104,9 @@ module de_chip_core
   input  link_t            link_i,       // .coll not used
   /* verilator lint_on UNUSEDSIGNAL */
   input  logic             blk1z_i,      // registered: link_i.data's block 1 is zero
+  /* verilator lint_off UNUSEDSIGNAL */
+  input  logic [IdW-1:0]   idsel_i,      // = link_i.id, a register of its own (not Compact)
+  /* verilator lint_on UNUSEDSIGNAL */
   output link_t            link_o,       // combinational: the last PE's bus (or bypass),
                                          // its pixel OR the PEs' pixels, two pixels met here
   input  chain_ctl_t       chain_ctl_i,
@@ -138,7 +151,7 @@ module de_chip_core
   logic [NumPe*ObsW-1:0]     obs_d, obs_q, obs_load;
 
   assign bus_id[0]   = link_i.id;
-  assign bus_idsel[0] = link_i.id;
+  assign bus_idsel[0] = idsel_i;
   assign bus_data[0] = link_i.data;
   assign bus_blk1z[0] = blk1z_i;
   assign pix_or[0]   = link_i.pix_valid ? link_i.pix : '0;
@@ -149,6 +162,7 @@ module de_chip_core
     logic [DataW-1:0] pe_data;
     logic             pe_blk1z;
     logic             pe_pixv;
+    logic             pe_pixvc;   // = pe_pixv, a copy for the valid chain and collision
     logic [PixW-1:0]  pe_pix;
     // Only the observation fields of the debug vector are used inside a chip.
     /* verilator lint_off UNUSEDSIGNAL */
@@ -164,7 +178,7 @@ module de_chip_core
 
     logic [IdW-1:0]   pe_idsel;
     de_pe #(.CarryBug(CarryBug), .Compact(Compact), .RstW(PeRstW),
-            .IdCopy((Compact == 1) ? 0 : 1)) u_pe (
+            .IdCopy((Compact == 1) ? 0 : 1), .PixCopy((Compact == 1) ? 0 : 1)) u_pe (
       .clk_i,
       .rst_i      (pe_rst[i]),
       .bypass_i   (pe_byp[i]),
@@ -178,6 +192,7 @@ module de_chip_core
       .blk1z_o    (pe_blk1z),
       .idsel_o    (pe_idsel),
       .pix_valid_o(pe_pixv),
+      .pixv_c_o   (pe_pixvc),
       .pix_o      (pe_pix),
       .dbg_o      (pe_dbg)
     );
@@ -211,8 +226,8 @@ module de_chip_core
     // front of it, a PE in use adds its pixel. At most one PE of the whole array drives a
     // pixel in a cycle, so OR is a mux.
     assign src_pix[i]  = byp_q[i] ? byp_pix_q  : (pe_pixv ? pe_pix : '0);
-    assign src_pixv[i] = byp_q[i] ? byp_pixv_q : pe_pixv;
-    assign coll[i]     = pixv_or[i] && pe_pixv && !byp_q[i];
+    assign src_pixv[i] = byp_q[i] ? byp_pixv_q : pe_pixvc;
+    assign coll[i]     = pixv_or[i] && pe_pixvc && !byp_q[i];
     // A bypassed PE's stage-1 identifier register carries the passing slots; the
     // observation word shows zero there, as it did when the PE's id_q was in reset: from
     // the clock after the bypass bit is set to the clock after it is cleared (byp_id0_q).
@@ -335,12 +350,17 @@ endmodule
 // count and give both buses exactly one register per chip (docs/array.md).
 module de_chip_bound
   import de_pkg::*;
-(
-  input  logic  clk_i,
-  input  logic  rst_i,
-  input  link_t link_i,
-  output link_t link_o,
-  output logic  blk1z_o   // timing only: link_o.data's block 1 is zero (registered)
+#(
+  // Timing only: 1 = idsel_o is a register of its own (a copy of id_q for the next chip's
+  // PE 0 operand selects, de_pe IdCopy); 0 = idsel_o is id_q.
+  parameter int unsigned IdCopy = 0
+) (
+  input  logic            clk_i,
+  input  logic            rst_i,
+  input  link_t           link_i,
+  output link_t           link_o,
+  output logic            blk1z_o,  // timing only: link_o.data's block 1 is zero (registered)
+  output logic [IdW-1:0]  idsel_o   // timing only: = link_o.id in every cycle
 );
   // One register per field, named as the trace harness binds them (sim/harness).
   logic [IdW-1:0]   id_q;
@@ -350,9 +370,32 @@ module de_chip_bound
   logic             coll_q;
   logic             blk1z_q;
 
-  always_ff @(posedge clk_i) begin
-    if (rst_i) {id_q, data_q, pixv_q, pix_q, coll_q} <= '0;
-    else       {id_q, data_q, pixv_q, pix_q, coll_q} <= link_i;
+  if (IdCopy == 1) begin : g_idsel
+    // id_q and its copy as kept per-bit processes: otherwise yosys' opt_merge folds the
+    // copy into id_q (docs/fpga.md section 6.3, third and fourth pass).
+    logic [IdW-1:0] idsel_q;
+    for (genvar k = 0; k < IdW; k++) begin : g_bit
+      (* keep *) always_ff @(posedge clk_i) begin
+        if (rst_i) id_q[k] <= 1'b0;
+        else       id_q[k] <= link_i.id[k];
+      end
+      (* keep *) always_ff @(posedge clk_i) begin
+        if (rst_i) idsel_q[k] <= 1'b0;
+        else       idsel_q[k] <= link_i.id[k];
+      end
+    end
+    always_ff @(posedge clk_i) begin
+      if (rst_i) {data_q, pixv_q, pix_q, coll_q} <= '0;
+      else       {data_q, pixv_q, pix_q, coll_q} <= {link_i.data, link_i.pix_valid,
+                                                     link_i.pix, link_i.coll};
+    end
+    assign idsel_o = idsel_q;
+  end else begin : g_no_idsel
+    always_ff @(posedge clk_i) begin
+      if (rst_i) {id_q, data_q, pixv_q, pix_q, coll_q} <= '0;
+      else       {id_q, data_q, pixv_q, pix_q, coll_q} <= link_i;
+    end
+    assign idsel_o = id_q;
   end
   // The next chip's PE 0 reads its zero test of block 1 from a flip-flop too; its input
   // here is the last PE's bus register, so the test is the only logic in front of it.

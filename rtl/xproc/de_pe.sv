@@ -29,7 +29,10 @@ module de_pe
   // Timing only: 1 = the stage-0 operand selects read idsel_i, a second copy of the
   // previous PE's identifier register, so that they do not wait on id_i's fan-out to the
   // whole decode (docs/fpga.md section 6.3, fourth pass); 0 = they read id_i.
-  parameter int unsigned IdCopy = 0
+  parameter int unsigned IdCopy = 0,
+  // Timing only: 1 = pixv_c_o is a register of its own (a copy of the pixel-valid register
+  // for the chip's collision flag and valid chain); 0 = pixv_c_o is pix_valid_o.
+  parameter int unsigned PixCopy = 0
 ) (
   input  logic             clk_i,
   // Synchronous, active high. RstW copies of ONE reset, equal in every cycle (registered
@@ -59,6 +62,7 @@ module de_pe
   output logic             blk1z_o,      // registered: data_o's block 1 is zero
   output logic [IdW-1:0]   idsel_o,      // = id_o (a register of its own when IdCopy = 1)
   output logic             pix_valid_o,  // registered: a Refresh's pixel this cycle
+  output logic             pixv_c_o,     // = pix_valid_o (a register of its own: PixCopy)
   output logic [PixW-1:0]  pix_o,        // registered: D[35:24], zero when not valid
   output logic [DbgW-1:0]  dbg_o         // all state, for the testbench (unused in a chip)
 );
@@ -231,7 +235,7 @@ module de_pe
   // = (ev1 || st1) && act1_q && !prot1_q && (id1.dst != RegNone), i.e. wr0 a cycle ago,
   // split by id1.dst then (wr1_q): no decode of the identifier in front of the register
   // blocks' next values, which src1_d/dst1_d select from (the critical path before).
-  assign wr1     = wr1_q;
+  // wr1 is assigned with wr1_d below (g_wr_fast / g_wr_small).
   // Dis and Eval0 are range addresses: fire = X was 0 and dX is not; the slot's kind and
   // X == 0 were registered in its stage 0 (disx_q, e0x_q), the zero test of dX is now.
   assign dis1    = disx_q && !z1;
@@ -308,8 +312,7 @@ module de_pe
   assign sn2     = {1'b0, in_blk[2]} + {1'b0, src2} + blk_carry_in(c2_q, 2, Bug);
   assign s2      = prot2_q ? sp2 : sn2;
   // = (ev2 || st2) && act2_q && !prot2_q && (id2.dst != RegNone), i.e. wr1 a cycle ago,
-  // split by destination as wr1.
-  assign wr2     = wr2_q;
+  // split by destination as wr1 (assigned below, g_wr_fast / g_wr_small).
   assign out2    = (active2 && live) ? s2[BlkW-1:0] : in_blk[2];
 
   // ---- accumulator: ACC decided in its stage 1, D block j written in stage j+1 ----------
@@ -459,9 +462,23 @@ module de_pe
   // wr1/wr2 are wr0/wr1 one cycle on; the slot in stage 0 (1) reads block 1 (2) next
   // cycle, after this cycle's writes, hence the operands from a_d, b_d, c_d.
   // Split by destination (wr0 implies id0.dst != RegNone, so the case's default is C).
-  assign wr1_d  = {wr0 && (id0.dst == RegC), wr0 && (id0.dst == RegB),
-                   wr0 && (id0.dst == RegA)};
-  assign wr2_d  = wr1;
+  // The Compact PE (the iCE40 chip, which is full) registers one write bit per stage and
+  // decodes the destination behind it, as before the split: wr1_q[0]/wr2_q[0] only (bits
+  // 2:1 constant zero, removed by synthesis), the same cycle behaviour.
+  if (Compact == 1) begin : g_wr_small
+    assign wr1_d = {2'b00, wr0};
+    assign wr2_d = {2'b00, wr1_q[0]};
+    assign wr1   = {wr1_q[0] && (id1.dst != RegA) && (id1.dst != RegB),
+                    wr1_q[0] && (id1.dst == RegB), wr1_q[0] && (id1.dst == RegA)};
+    assign wr2   = {wr2_q[0] && (id2.dst != RegA) && (id2.dst != RegB),
+                    wr2_q[0] && (id2.dst == RegB), wr2_q[0] && (id2.dst == RegA)};
+  end else begin : g_wr_fast
+    assign wr1_d = {wr0 && (id0.dst == RegC), wr0 && (id0.dst == RegB),
+                    wr0 && (id0.dst == RegA)};
+    assign wr2_d = wr1;
+    assign wr1   = wr1_q;
+    assign wr2   = wr2_q;
+  end
   // (Compact: plain, blk1z_d does not use src1.)
   assign src1_d = (sum0 || Compact == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
@@ -567,7 +584,6 @@ module de_pe
       accc2_q  <= 1'b0;
       accen3_q <= 1'b0;
       accc3_q  <= 1'b0;
-      pixv_q   <= 1'b0;
       pix_q    <= '0;
       aez_q    <= 1'b0;
       aenz_q   <= 1'b0;
@@ -599,7 +615,6 @@ module de_pe
       accc2_q  <= accc2_d;
       accen3_q <= accen3_d;
       accc3_q  <= accc3_d;
-      pixv_q   <= pixv_d;
       pix_q    <= pix_d;
       aez_q    <= aez_d;
       aenz_q   <= aenz_d;
@@ -616,14 +631,15 @@ module de_pe
   // The second copy of id_q for the next PE's operand selects: a kept process of its own,
   // or yosys' opt_merge folds it into id_q (docs/fpga.md section 6.3, third pass).
   // One kept process per bit, for id_q as for its copy: a keep on a vector's process, or
-  // on one of the two copies only, still lets opt_merge fold them into one.
-  for (genvar k = 0; k < IdW; k++) begin : g_id_bit
-    (* keep *) always_ff @(posedge clk_i) begin
-      if (rst_bus) id_q[k] <= 1'b0;
-      else         id_q[k] <= id_d[k];
-    end
-  end
+  // on one of the two copies only, still lets opt_merge fold them into one. Without the
+  // copy (IdCopy = 0) id_q is a plain register (synthesis may then drop unread bits).
   if (IdCopy == 1) begin : g_idsel
+    for (genvar k = 0; k < IdW; k++) begin : g_id_bit
+      (* keep *) always_ff @(posedge clk_i) begin
+        if (rst_bus) id_q[k] <= 1'b0;
+        else         id_q[k] <= id_d[k];
+      end
+    end
     logic [IdW-1:0] idsel_q;
     for (genvar k = 0; k < IdW; k++) begin : g_bit
       (* keep *) always_ff @(posedge clk_i) begin
@@ -633,7 +649,32 @@ module de_pe
     end
     assign idsel_o = idsel_q;
   end else begin : g_no_idsel
+    always_ff @(posedge clk_i) begin
+      if (rst_bus) id_q <= '0;
+      else         id_q <= id_d;
+    end
     assign idsel_o = id_q;
+  end
+
+  // The pixel-valid register and, with PixCopy, a copy of it for the chip's collision
+  // flag and valid chain (de_chip), each a kept process (opt_merge, as for id_q).
+  if (PixCopy == 1) begin : g_pixv_copy
+    logic pixvc_q;
+    (* keep *) always_ff @(posedge clk_i) begin
+      if (hold_ctl) pixv_q <= 1'b0;
+      else          pixv_q <= pixv_d;
+    end
+    (* keep *) always_ff @(posedge clk_i) begin
+      if (hold_ctl) pixvc_q <= 1'b0;
+      else          pixvc_q <= pixv_d;
+    end
+    assign pixv_c_o = pixvc_q;
+  end else begin : g_pixv
+    always_ff @(posedge clk_i) begin
+      if (hold_ctl) pixv_q <= 1'b0;
+      else          pixv_q <= pixv_d;
+    end
+    assign pixv_c_o = pixv_q;
   end
 
   // ---- outputs ----------------------------------------------------------------------------

@@ -39,6 +39,7 @@ module de_fast_head
     .clk_i, .rst_i, .link_o, .chain_o,
     .link_i     (skew_link),
     .blk1z_i    (skew_blk1z_q),
+    .idsel_i    (skew_link.id),   // as in de_array: chip 0's copy is the input itself
     .chain_ctl_i({cfg_mode_i, obs_load_i, obs_shift_i}),
     .chain_i    ({cfg_bit_i, 1'b0}),
     .bypass_o   (bypass)

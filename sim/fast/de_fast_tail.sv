@@ -19,9 +19,11 @@ module de_fast_tail
   link_t b_link;
   /* verilator lint_off UNUSEDSIGNAL */
   logic  b_blk1z;  // timing only, for a next chip's PE 0: there is none
+  logic [IdW-1:0] b_idsel;  // likewise
   /* verilator lint_on UNUSEDSIGNAL */
 
-  de_chip_bound u_bound (.clk_i, .rst_i, .link_i, .link_o(b_link), .blk1z_o(b_blk1z));
+  de_chip_bound u_bound (.clk_i, .rst_i, .link_i, .link_o(b_link), .blk1z_o(b_blk1z),
+                         .idsel_o(b_idsel));
 
   de_deskew u_deskew (
     .clk_i, .rst_i,

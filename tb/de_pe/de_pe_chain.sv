@@ -8,7 +8,10 @@ module de_pe_chain
   import de_pkg::*;
 #(
   parameter int unsigned N        = 9,
-  parameter int unsigned CarryBug = 0
+  parameter int unsigned CarryBug = 0,
+  // de_pe Compact (1: the iCE40 form); the fast form (0) also takes the identifier copy
+  // (de_pe IdCopy = 1, idsel_i/idsel_o chained as in de_chip).
+  parameter int unsigned Compact  = 0
 ) (
   input  logic               clk_i,
   input  logic               rst_i,
@@ -51,22 +54,28 @@ module de_pe_chain
   logic [N:0][IdW-1:0]   id_link;
   logic [N:0][DataW-1:0] data_link;
   logic [N:0]            blk1z_link;
+  logic [N:0][IdW-1:0]   idsel_link;
   assign id_link[0]   = id_i;
+  assign idsel_link[0] = id_i;
   assign data_link[0] = {sk2b_q, sk1_q, data_i[BlkW-1:0]};
   assign blk1z_link[0] = sk1z_q;
 
   for (genvar p = 0; p < N; p++) begin : g_pe
     de_pe #(
-      .CarryBug(CarryBug)
+      .CarryBug(CarryBug),
+      .Compact (Compact),
+      .IdCopy  ((Compact == 1) ? 0 : 1)
     ) u_pe (
       .clk_i,
       .rst_i,
       .id_i       (id_link[p]),
       .data_i     (data_link[p]),
       .blk1z_i    (blk1z_link[p]),
+      .idsel_i    (idsel_link[p]),
       .id_o       (id_link[p+1]),
       .data_o     (data_link[p+1]),
       .blk1z_o    (blk1z_link[p+1]),
+      .idsel_o    (idsel_link[p+1]),
       .pix_valid_o(pix_valid_o[p]),
       .pix_o      (pix_o[p*PixW +: PixW]),
       .dbg_o      (dbg_o[p*DbgW +: DbgW])

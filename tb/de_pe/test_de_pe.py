@@ -409,12 +409,12 @@ def _sources() -> list[Path]:
     return rtl_files("diffengine:tb:de_pe")
 
 
-def _run(carry_bug: int, n_pe: int = 9) -> None:
+def _run(carry_bug: int, n_pe: int = 9, compact: int = 0) -> None:
     from cocotb_tools.runner import get_runner
 
     runner = get_runner("verilator")
-    params = {"N": n_pe, "CarryBug": carry_bug}
-    build_dir = TB_DIR / f"sim_build_N{n_pe}_CarryBug{carry_bug}"
+    params = {"N": n_pe, "CarryBug": carry_bug, "Compact": compact}
+    build_dir = TB_DIR / f"sim_build_N{n_pe}_CarryBug{carry_bug}_Compact{compact}"
     runner.build(
         sources=_sources(),
         hdl_toplevel="de_pe_chain",
@@ -440,8 +440,11 @@ def _run(carry_bug: int, n_pe: int = 9) -> None:
 try:
     import pytest
 
+    # Compact: de_pe's two forms of its timing-only logic (the fast one with the
+    # identifier copy, IdCopy); the cycle behaviour must be the same in both.
+    @pytest.mark.parametrize("compact", [0, 1])
     @pytest.mark.parametrize("carry_bug", [0, 1])
-    def test_de_pe(carry_bug):
-        _run(carry_bug)
+    def test_de_pe(carry_bug, compact):
+        _run(carry_bug, compact=compact)
 except ImportError:  # pragma: no cover
     pass
