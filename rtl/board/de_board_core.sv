@@ -31,14 +31,7 @@ module de_board_core #(
   parameter int unsigned TimeoutBits = 22,
   parameter int unsigned BufDepth    = 16,
   parameter int unsigned MaxLines    = 512,
-  parameter int unsigned TestHActive = 32'(de_pkg::VideoTestDefault.h_act),
-  parameter int unsigned TestHFp     = 32'(de_pkg::VideoTestDefault.h_fp),
-  parameter int unsigned TestHSync   = 32'(de_pkg::VideoTestDefault.h_sync),
-  parameter int unsigned TestHBp     = 32'(de_pkg::VideoTestDefault.h_bp),
-  parameter int unsigned TestVActive = 32'(de_pkg::VideoTestDefault.v_act),
-  parameter int unsigned TestVFp     = 32'(de_pkg::VideoTestDefault.v_fp),
-  parameter int unsigned TestVSync   = 32'(de_pkg::VideoTestDefault.v_sync),
-  parameter int unsigned TestVBp     = 32'(de_pkg::VideoTestDefault.v_bp),
+  parameter de_pkg::video_mode_t TestMode = de_pkg::VideoTestDefault,  // mode_i = 3
   parameter int unsigned SpanArray   = 0,      // 1: span-serial arrays on clk_core_i
   parameter int unsigned SpanLatency = 300,    // their Refresh -> column 0, pixel clocks
   // Their pixel -> core FIFO, log2 slots: 2,048 slots hold the CAD scene's paced backlog
@@ -118,7 +111,7 @@ module de_board_core #(
       2'd0:    vactive = 12'd480;
       2'd1:    vactive = 12'd485;
       2'd2:    vactive = 12'd1024;
-      default: vactive = 12'(TestVActive);
+      default: vactive = TestMode.v_act;
     endcase
   end
 
@@ -167,14 +160,7 @@ module de_board_core #(
     .NumBins    (16),
     .BinShift   (7),
     .MaxLines   (MaxLines),
-    .TestHActive(TestHActive),
-    .TestHFp    (TestHFp),
-    .TestHSync  (TestHSync),
-    .TestHBp    (TestHBp),
-    .TestVActive(TestVActive),
-    .TestVFp    (TestVFp),
-    .TestVSync  (TestVSync),
-    .TestVBp    (TestVBp),
+    .TestMode   (TestMode),
     .SpanArray  (SpanArray),
     .SpanLatency(SpanLatency),
     .SpanFifoAw (SpanFifoAw)

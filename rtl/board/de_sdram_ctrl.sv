@@ -69,6 +69,8 @@ module de_sdram_ctrl #(
   output de_sdram_pkg::sdram_out_t sd_o,
   input  logic [de_sdram_pkg::SdDqW-1:0] sd_dq_i
 );
+  import de_sdram_pkg::*;  // the command codes (sdram_cmd_e)
+
   // ---------------------------------------------------------------- parameter checks
   if (CasLatency != 2 && CasLatency != 3) begin : g_bad_cl
     $fatal(1, "de_sdram_ctrl: CasLatency must be 2 or 3");
@@ -128,15 +130,6 @@ module de_sdram_ctrl #(
     if (restart) return n <= 1;
     return (n <= 2) || (32'(v) >= n - 2);
   endfunction
-
-  // {cs_n, ras_n, cas_n, we_n}
-  localparam logic [3:0] CmdNop   = 4'b0111;
-  localparam logic [3:0] CmdAct   = 4'b0011;
-  localparam logic [3:0] CmdRead  = 4'b0101;
-  localparam logic [3:0] CmdWrite = 4'b0100;
-  localparam logic [3:0] CmdPre   = 4'b0010;
-  localparam logic [3:0] CmdRef   = 4'b0001;
-  localparam logic [3:0] CmdLmr   = 4'b0000;
 
   // Mode register: single-location writes (A9), CL, sequential, BL 8.
   localparam logic [PinAW-1:0] ModeWord =
@@ -202,7 +195,7 @@ module de_sdram_ctrl #(
   logic [TagW-1:0]     iss_tag_d, iss_tag_q;         // tag of the READ on the pins
 
   // Pins.
-  logic [3:0]          cmd_d, cmd_q;
+  de_sdram_pkg::sdram_cmd_e cmd_d, cmd_q;  // {cs_n, ras_n, cas_n, we_n}
   logic [BankBits-1:0] ba_d, ba_q;
   logic [PinAW-1:0]    a_d, a_q;
   logic [15:0]         dq_d, dq_q;

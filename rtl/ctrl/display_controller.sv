@@ -29,14 +29,8 @@ module display_controller #(
   parameter int unsigned NumBins     = 16,
   parameter int unsigned BinShift    = 7,
   parameter int unsigned MaxLines    = 1024,
-  parameter int unsigned TestHActive = 32'(de_pkg::VideoTestDefault.h_act),
-  parameter int unsigned TestHFp     = 32'(de_pkg::VideoTestDefault.h_fp),
-  parameter int unsigned TestHSync   = 32'(de_pkg::VideoTestDefault.h_sync),
-  parameter int unsigned TestHBp     = 32'(de_pkg::VideoTestDefault.h_bp),
-  parameter int unsigned TestVActive = 32'(de_pkg::VideoTestDefault.v_act),
-  parameter int unsigned TestVFp     = 32'(de_pkg::VideoTestDefault.v_fp),
-  parameter int unsigned TestVSync   = 32'(de_pkg::VideoTestDefault.v_sync),
-  parameter int unsigned TestVBp     = 32'(de_pkg::VideoTestDefault.v_bp),
+  // The test mode's geometry (mode_i = de_pkg::VideoModeTest), spec/video.toml's [test].
+  parameter de_pkg::video_mode_t TestMode = de_pkg::VideoTestDefault,
   parameter int unsigned SpanArray   = 0,
   parameter int unsigned SpanLatency = 300,
   // log2 of the span array's pixel -> core FIFO (slots); 8 keeps the tested default, the
@@ -92,12 +86,6 @@ module display_controller #(
   logic [NumCh-1:0][de_pkg::RecW-1:0] instr;
   logic [NumCh-1:0][11:0] pix;
   logic [NumCh-1:0]       pix_valid;
-
-  // The test mode's geometry as one value (its scalar parameters are what the testbenches
-  // and sim/dc's -G set; below the tops it travels as one de_pkg::video_mode_t).
-  localparam de_pkg::video_mode_t TestMode = {
-    12'(TestHActive), 12'(TestHFp), 12'(TestHSync), 12'(TestHBp),
-    12'(TestVActive), 12'(TestVFp), 12'(TestVSync), 12'(TestVBp), 2'b00};
 
   de_display_core #(
     .NumBuf      (NumBuf),

@@ -230,7 +230,7 @@ package de_pkg;
     logic        h_pol, v_pol;  // 1 = active-high sync pulse
   } video_mode_t;
   localparam logic [1:0] VideoModeTest = 2'd3;
-  // The test mode's default geometry (the Test* parameters of the tops).
+  // The test mode's default geometry (the tops' TestMode parameter).
   localparam video_mode_t VideoTestDefault = {12'd16, 12'd2, 12'd3, 12'd3,
                                             12'd6, 12'd1, 12'd2, 12'd2,
                                             1'b0, 1'b0};

@@ -62,7 +62,7 @@ struct Geom {
 // docs/display-controller.md §3; the fixed modes come from de_isa.h (spec/video.toml).
 Geom mode_geom(int mode) {
   if (mode == DE_VIDEO_MODE_TEST) {
-    const int t[8] = {DC_TEST_GEOM};  // the Test* parameters of this build
+    const int t[8] = {DC_TEST_GEOM};  // the TestMode parameter of this build
     return {t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], false, false};
   }
   const de_video_mode* m = de_video_mode_get(mode);

@@ -9,6 +9,8 @@ from __future__ import annotations
 import difflib
 from pathlib import Path
 
+import pytest
+
 from diffengine.isa import gen
 
 
@@ -47,3 +49,32 @@ def test_adder_carry_bug_model():
     assert isa.add_word(one_frac, 1) == 1 << isa.FRAC_BITS
     assert isa.add_word(one_frac, 1, carry_bug=True) == 2 << isa.FRAC_BITS
     assert isa.add_word(isa.WORD_MASK, 1) == 0
+
+
+def test_video_mode_param_is_de_pkg_layout():
+    """isa.video_mode_param packs spec/video.toml's test geometry into the same value as
+    de_pkg::VideoTestDefault (the struct's field order and widths), and reads it back."""
+    import re
+    import tomllib
+    from diffengine import isa
+    spec = tomllib.loads((gen.ROOT / "spec" / "video.toml").read_text())["test"]
+    pkg = (gen.ROOT / gen.SV_OUT).read_text()
+    concat = re.search(r"video_mode_t VideoTestDefault = \{([^}]*)\}", pkg).group(1)
+    word, bits = 0, 0
+    for w, base, digits in re.findall(r"(\d+)'([db])(\d+)", concat):
+        word = word << int(w) | int(digits, 10 if base == "d" else 2)
+        bits += int(w)
+    assert bits == isa.VIDEO_MODE_BITS
+    lit = isa.video_mode_param(spec["h"], spec["v"], spec["hpol"], spec["vpol"])
+    assert lit == f"{bits}'h{word:x}"
+    g = isa.video_mode_fields(word)
+    assert [g[k] for k in ("TestHActive", "TestHFp", "TestHSync", "TestHBp")] == spec["h"]
+    assert [g[k] for k in ("TestVActive", "TestVFp", "TestVSync", "TestVBp")] == spec["v"]
+    assert g["HTotal"] == sum(spec["h"]) and g["VTotal"] == sum(spec["v"])
+    g = isa.video_mode_fields(int(isa.video_mode_param((9, 16, 96, 679), (16, 1, 2, 2))
+                                  .split("'h")[1], 16))
+    assert (g["TestHBp"], g["TestVActive"], g["HTotal"]) == (679, 16, 800)
+    with pytest.raises(ValueError):
+        isa.video_mode_param((4096, 1, 1, 1), (1, 1, 1, 1))
+    with pytest.raises(ValueError):
+        isa.video_mode_param((1, 1, 1), (1, 1, 1, 1))

@@ -16,14 +16,7 @@ module tb_board_sdram #(
   parameter int unsigned TimeoutBits = 22,
   parameter int unsigned BufDepth    = 16,
   parameter int unsigned MaxLines    = 512,
-  parameter int unsigned TestHActive = 32'(de_pkg::VideoTestDefault.h_act),
-  parameter int unsigned TestHFp     = 32'(de_pkg::VideoTestDefault.h_fp),
-  parameter int unsigned TestHSync   = 32'(de_pkg::VideoTestDefault.h_sync),
-  parameter int unsigned TestHBp     = 32'(de_pkg::VideoTestDefault.h_bp),
-  parameter int unsigned TestVActive = 32'(de_pkg::VideoTestDefault.v_act),
-  parameter int unsigned TestVFp     = 32'(de_pkg::VideoTestDefault.v_fp),
-  parameter int unsigned TestVSync   = 32'(de_pkg::VideoTestDefault.v_sync),
-  parameter int unsigned TestVBp     = 32'(de_pkg::VideoTestDefault.v_bp),
+  parameter de_pkg::video_mode_t TestMode = de_pkg::VideoTestDefault,
   parameter int unsigned SpanArray   = 0,
   parameter int unsigned SpanLatency = 300
 ) (
@@ -50,10 +43,8 @@ module tb_board_sdram #(
   de_board_core #(
     .NumChips(NumChips), .CarryBug(CarryBug), .PfDepth(PfDepth), .SdTckPs(8000),
     .SdTinitNs(SdTinitNs), .UartClkHz(UartClkHz), .Baud(Baud), .TimeoutBits(TimeoutBits),
-    .BufDepth(BufDepth), .MaxLines(MaxLines), .TestHActive(TestHActive),
-    .TestHFp(TestHFp), .TestHSync(TestHSync), .TestHBp(TestHBp),
-    .TestVActive(TestVActive), .TestVFp(TestVFp), .TestVSync(TestVSync),
-    .TestVBp(TestVBp), .SpanArray(SpanArray), .SpanLatency(SpanLatency)
+    .BufDepth(BufDepth), .MaxLines(MaxLines), .TestMode(TestMode),
+    .SpanArray(SpanArray), .SpanLatency(SpanLatency)
   ) u_core (
     .clk_i, .clk_core_i, .clk_sdram_i, .rst_i, .mode_i, .uart_rx_i, .uart_tx_o, .tmds_o,
     .led_o, .rgb8_o, .hsync_o, .vsync_o, .blank_o,

@@ -152,11 +152,8 @@ async def test_tmds_encoder(dut):
 # ====================================================================== board top
 def geom(dut) -> dict:
     g = {k: int(getattr(dut, k).value) for k in (
-        "TestHActive", "TestHFp", "TestHSync", "TestHBp", "TestVActive", "TestVFp",
-        "TestVSync", "TestVBp", "NumChips", "CarryBug", "PfDepth", "UartClkHz",
-        "Baud", "TimeoutBits", "BufDepth")}
-    g["HTotal"] = g["TestHActive"] + g["TestHFp"] + g["TestHSync"] + g["TestHBp"]
-    g["VTotal"] = g["TestVActive"] + g["TestVFp"] + g["TestVSync"] + g["TestVBp"]
+        "NumChips", "CarryBug", "PfDepth", "UartClkHz", "Baud", "TimeoutBits", "BufDepth")}
+    g.update(isa.video_mode_fields(int(dut.TestMode.value)))
     g["n_pe"] = 9 * g["NumChips"]
     g["bit_ps"] = round(1e12 / g["Baud"])             # the host's exact bit period
     g["bit_pix"] = -(-g["bit_ps"] // PIX_PS)          # ... in pixel clocks, rounded up
@@ -641,8 +638,8 @@ async def test_shell_serialiser(dut):
 BOARD = dict(NumChips=1, CarryBug=1, PfDepth=16, SdTinitNs=2000, UartClkHz=78_125_000,
              Baud=3_000_000,
              TimeoutBits=11,
-             BufDepth=16, MaxLines=8, TestHActive=9, TestHFp=2, TestHSync=3, TestHBp=3,
-             TestVActive=6, TestVFp=1, TestVSync=2, TestVBp=2)
+             BufDepth=16, MaxLines=8,
+             TestMode=isa.video_mode_param((9, 2, 3, 3), (6, 1, 2, 2)))
 
 
 def board_sources():

@@ -36,6 +36,7 @@ def build_and_test(tb_dir: Path, toplevel: str, sources: list[Path], test_module
     also their lint gate), otherwise warnings do not stop the build."""
     parameters = parameters or {}
     tag = "_".join(f"{k}{v}" for k, v in sorted(parameters.items())) or "default"
+    tag = tag.replace("'", "")  # a Verilog literal's quote (98'h...), not in a folder name
     build_dir = tb_dir / f"sim_build_{tag}"
     runner = get_runner("verilator")
     # ccache, when installed, compiles the Verilated C++ (sim/Makefile does the same);

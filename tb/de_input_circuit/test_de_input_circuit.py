@@ -21,10 +21,11 @@ N_WORDS = 4000
 async def mapper_matches_model(dut):
     from common.run import seed_from_env
     rng = random.Random(seed_from_env())
-    from common.run import hold_reset
+    from common.run import drive, hold_reset
     await hold_reset(dut, 3, falling=False, clock_ns=10, valid_i=0, word_i=0, window_i=0,
                      compensate_i=0)
 
+    mapper, skew, deskew = dut.u_mapper, dut.u_skew, dut.u_deskew
     history: list[tuple[int, int]] = []  # (ident, data) seen at the mapper output
     checked = 0
     window, comp = 0, 0
@@ -34,14 +35,11 @@ async def mapper_matches_model(dut):
             window, comp = rng.randrange(5), rng.randrange(2)
         word = (rng.randrange(32) << 27) | rng.getrandbits(27)
         valid = rng.random() < 0.9
-        dut.valid_i.value = int(valid)
-        dut.word_i.value = word
-        dut.window_i.value = window
-        dut.compensate_i.value = comp
+        drive(dut, valid_i=int(valid), word_i=word, window_i=window, compensate_i=comp)
         ident, data = map_word(word, window, bool(comp)) if valid else (0, 0)
         await RisingEdge(dut.clk_i)      # the mapper registers this word
         await ReadOnly()
-        got = (int(dut.valid_o.value), int(dut.id_o.value), int(dut.data_o.value))
+        got = (int(mapper.valid_o.value), int(mapper.id_o.value), int(mapper.data_o.value))
         assert got == (int(valid), ident, data), (
             f"word 0x{word:08x} window {window} comp {comp}: got valid/ident/data "
             f"{got[0]}/0x{got[1]:03x}/0x{got[2]:09x}, want {int(valid)}/0x{ident:03x}/0x{data:09x}")
@@ -49,14 +47,14 @@ async def mapper_matches_model(dut):
         checked += 1
         # skew: block j comes from the word that left the mapper j clocks ago.
         if len(history) >= 3:
-            blk = int(dut.skew_blk_o.value)
+            blk = int(skew.blk_o.value)
             assert blk & 0xFFF == history[-1][1] & 0xFFF
             assert (blk >> 12) & 0xFFF == (history[-2][1] >> 12) & 0xFFF
             assert (blk >> 24) & 0xFFF == (history[-3][1] >> 24) & 0xFFF
-            assert int(dut.skew_ident_o.value) == history[-1][0]
+            assert int(skew.id_o.value) == history[-1][0]
             # deskew restores whole words two clocks later.
-            assert int(dut.deskew_data_o.value) == history[-3][1]
-            assert int(dut.deskew_ident_o.value) == history[-3][0]
+            assert int(deskew.data_o.value) == history[-3][1]
+            assert int(deskew.id_o.value) == history[-3][0]
     assert checked == N_WORDS
     dut._log.info(f"checked {checked} mapped words and their skew/deskew")
 

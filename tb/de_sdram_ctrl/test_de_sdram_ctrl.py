@@ -99,23 +99,18 @@ class Bench:
         wr_ready = int(dut.wr_ready_o.value)
         assert not (rd_ready and wr_ready), f"cycle {self.cycle}: both ports ready"
         took_rd = took_wr = False
-        dut.rd_req_valid_i.value = int(rd is not None)
-        dut.wr_valid_i.value = int(wr is not None)
+        drive(dut, rd_req_valid_i=int(rd is not None), wr_valid_i=int(wr is not None))
         if rd is not None:
             addr, tag = rd
-            dut.rd_req_addr_i.value = addr
-            dut.rd_req_tag_i.value = tag
-            if rd_ready:
-                took_rd = True
-                base = addr & ~3
-                for i in range(4):
-                    self.expect.append((tag, self.mem.get(base + i, 0)))
+            drive(dut, rd_req_addr_i=addr, rd_req_tag_i=tag)
+            took_rd = bool(rd_ready)
+            if took_rd:
+                self.expect += [(tag, self.mem.get((addr & ~3) + i, 0)) for i in range(4)]
         if wr is not None:
             addr, word = wr
-            dut.wr_addr_i.value = addr
-            dut.wr_data_i.value = word
-            if wr_ready:
-                took_wr = True
+            drive(dut, wr_addr_i=addr, wr_data_i=word)
+            took_wr = bool(wr_ready)
+            if took_wr:
                 self.mem[addr] = word
         return took_rd, took_wr
 

@@ -64,10 +64,9 @@ async def run(dut, slots, seed: int):
         dut.data_i.value = data
         await RisingEdge(dut.clk_i)
         await ReadOnly()
-        a.append((int(dut.a_pixel_valid_o.value),
-                  int(dut.a_pixel_o.value) if int(dut.a_pixel_valid_o.value) else 0))
-        s.append((int(dut.s_pixel_valid_o.value),
-                  int(dut.s_pixel_o.value) if int(dut.s_pixel_valid_o.value) else 0))
+        for arr, out in ((dut.u_array, a), (dut.u_span, s)):
+            valid = int(arr.pix_valid_o.value)
+            out.append((valid, int(arr.pix_o.value) if valid else 0))
     return a, s
 
 
@@ -85,8 +84,8 @@ async def same_pixels_fixed_latency(dut):
     n, htotal = 9 * chips, int(os.environ.get("DE_HTOTAL", 120))
     cmds = randgen.stream(seed, int(os.environ.get("N_CMDS", 150)), n, (1, 6))
     a, s = await run(dut, lines_of(cmds, htotal), seed)
-    assert not int(dut.overflow_o.value), "a slot found the FIFO full"
-    assert not int(dut.late_o.value), "a line was not ready at its read-out"
+    assert not int(dut.u_span.overflow_o.value), "a slot found the FIFO full"
+    assert not int(dut.u_span.late_o.value), "a line was not ready at its read-out"
     d = lat - (chips + 3)
     assert d >= 0
     assert s[d:] == a[:len(a) - d], "span array's pixel bus differs from de_array's"
@@ -106,7 +105,7 @@ async def late_is_flagged(dut):
         [isa.Command("REFRESH")]
     await run(dut, lines_of(cmds, 80), 1)
     lat = int(dut.Latency.value)
-    assert int(dut.late_o.value), f"Latency {lat} is too small, yet late_o stayed low"
+    assert int(dut.u_span.late_o.value), f"Latency {lat} is too small, yet late_o stayed low"
 
 
 # (chips, latency, carry bug). 18 columns; Latency 60 is ample for these lines (HTotal

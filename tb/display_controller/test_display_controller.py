@@ -51,12 +51,9 @@ MASK48 = (1 << 48) - 1
 
 
 def geom(dut):
-    g = {k: int(getattr(dut, k).value) for k in (
-        "TestHActive", "TestHFp", "TestHSync", "TestHBp",
-        "TestVActive", "TestVFp", "TestVSync", "TestVBp", "NumBuf", "NumChips",
-        "CarryBug", "BufDepth")}
-    g["HTotal"] = g["TestHActive"] + g["TestHFp"] + g["TestHSync"] + g["TestHBp"]
-    g["VTotal"] = g["TestVActive"] + g["TestVFp"] + g["TestVSync"] + g["TestVBp"]
+    g = {k: int(getattr(dut, k).value) for k in ("NumBuf", "NumChips", "CarryBug",
+                                                 "BufDepth")}
+    g.update(isa.video_mode_fields(int(dut.TestMode.value)))
     g["n_pe"] = 9 * g["NumChips"]
     g["SpanArray"] = int(dut.SpanArray.value)
     g["ArrayLatency"] = int(dut.SpanLatency.value) if g["SpanArray"] else g["NumChips"] + 3
@@ -522,14 +519,14 @@ RUNS = {
                         BinShift=3, MaxLines=8),
     # 1 chip = 9 PEs: HActive 9, line 17 slots; the carry bug in all three arrays.
     "chips1_bug1": dict(NumChips=1, CarryBug=1, NumBuf=3, BufDepth=16, NumBins=4,
-                        BinShift=2, MaxLines=8, TestHActive=9, TestHFp=2, TestHSync=3,
-                        TestHBp=3),
+                        BinShift=2, MaxLines=8,
+                        TestMode=isa.video_mode_param((9, 2, 3, 3), (6, 1, 2, 2))),
     # Busy frame with 640x480's line: HTotal 800 (window 799 slots), 9 active columns
     # (one chip; the pixels are still checked), 16 active lines, 4 y-processors with the
     # default buffers. Gives the bus-utilisation figure of docs/performance.md.
     "busy800": dict(NumChips=1, CarryBug=0, NumBuf=4, BufDepth=16, NumBins=16,
-                    BinShift=7, MaxLines=16, TestHActive=9, TestHFp=16, TestHSync=96,
-                    TestHBp=679, TestVActive=16, TestVFp=1, TestVSync=2, TestVBp=2),
+                    BinShift=7, MaxLines=16,
+                    TestMode=isa.video_mode_param((9, 16, 96, 679), (16, 1, 2, 2))),
     # The span-serial array (docs/fpga.md 3) in place of each de_array: 18 columns in
     # block RAM on its own clock, pixels 30 pixel clocks after the Refresh.
     "span_chips2": dict(NumChips=2, CarryBug=0, NumBuf=2, BufDepth=32, NumBins=4,

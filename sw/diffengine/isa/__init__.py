@@ -193,3 +193,34 @@ def split_lines(commands) -> list[list[Command]]:
     if cur:
         lines.append(cur)
     return lines
+
+
+# ---- video modes -----------------------------------------------------------------
+# de_pkg::video_mode_t (generated from spec/video.toml), MSB first: h_act, h_fp, h_sync,
+# h_bp, v_act, v_fp, v_sync, v_bp of 12 bits each, then h_pol, v_pol.
+VIDEO_FIELD_BITS = 12
+VIDEO_MODE_BITS = 8 * VIDEO_FIELD_BITS + 2
+
+
+def video_mode_param(h, v, hpol: bool = False, vpol: bool = False) -> str:
+    """A de_pkg::video_mode_t as a Verilog literal, for a top's TestMode parameter (-G):
+    h and v are (active, front porch, sync, back porch)."""
+    if len(h) != 4 or len(v) != 4 or not all(0 <= n < 1 << VIDEO_FIELD_BITS
+                                             for n in (*h, *v)):
+        raise ValueError(f"video mode {h} {v}: 4 + 4 values of 0..4095")
+    word = 0
+    for n in (*h, *v):
+        word = word << VIDEO_FIELD_BITS | n
+    return f"{VIDEO_MODE_BITS}'h{word << 2 | int(hpol) << 1 | int(vpol):x}"
+
+
+def video_mode_fields(word: int) -> dict:
+    """A de_pkg::video_mode_t read back (a top's TestMode): the tops' old parameter names
+    TestHActive ... TestVBp, HTotal and VTotal."""
+    names = ("TestHActive", "TestHFp", "TestHSync", "TestHBp",
+             "TestVActive", "TestVFp", "TestVSync", "TestVBp")
+    mask = (1 << VIDEO_FIELD_BITS) - 1
+    g = {k: word >> (2 + VIDEO_FIELD_BITS * (7 - i)) & mask for i, k in enumerate(names)}
+    g["HTotal"] = sum(g[k] for k in names[:4])
+    g["VTotal"] = sum(g[k] for k in names[4:])
+    return g

@@ -278,7 +278,7 @@ def gen_sv(spec: dict) -> str:
           "    logic        h_pol, v_pol;  // 1 = active-high sync pulse",
           "  } video_mode_t;",
           f"  localparam logic [1:0] VideoModeTest = 2'd{spec['video']['test']['index']};",
-          "  // The test mode's default geometry (the Test* parameters of the tops).",
+          "  // The test mode's default geometry (the tops' TestMode parameter).",
           "  localparam video_mode_t VideoTestDefault = "
           + sv_mode(spec["video"]["test"]).replace("\n" + " " * 25, "\n" + " " * 44) + ";",
           "",

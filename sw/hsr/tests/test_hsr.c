@@ -28,6 +28,16 @@ static int llr_count(const hsr_ctx *h)
     return c;
 }
 
+/* The id hsr_pick finds at (x, y), NO_HIT (HSR_ENOTFOUND) or PICK_ERROR (any other
+ * status); neither is an id, nor t_add_rect's -1. */
+enum { NO_HIT = -100, PICK_ERROR = -101 };
+static int pick(const hsr_ctx *h, int64_t x, int64_t y, hsr_pick_mode mode)
+{
+    int id = -1;
+    hsr_status st = hsr_pick(h, x, y, mode, &id);
+    return st == HSR_OK ? id : st == HSR_ENOTFOUND ? NO_HIT : PICK_ERROR;
+}
+
 static void test_hsr_two_opaque_overlap_any_order(void)
 {
     for (int order = 0; order < 2; order++) {
@@ -132,22 +142,21 @@ static void test_hsr_transparent_parents_and_pick(void)
     hsr_ctx *h = t_ctx();
     int o = t_add_rect(h, 0, 0, 20, 20, 0, 1, 1);
     int t = t_add_rect(h, 10, 10, 30, 30, 0, 0, 0.5);
-    int id = -1;
-    CHECK(hsr_pick(h, 15, 15, HSR_PICK_VISIBLE, &id) == HSR_OK && id == t);
-    CHECK(hsr_pick(h, 15, 15, HSR_PICK_NEXT_BEHIND, &id) == HSR_OK && id == o);
-    CHECK(hsr_pick(h, 15, 15, HSR_PICK_FIRST_OPAQUE, &id) == HSR_OK && id == o);
-    CHECK(hsr_pick(h, 25, 25, HSR_PICK_FIRST_OPAQUE, &id) == HSR_ENOTFOUND);
-    CHECK(hsr_pick(h, 5, 5, HSR_PICK_VISIBLE, &id) == HSR_OK && id == o);
-    CHECK(hsr_pick(h, 100, 100, HSR_PICK_VISIBLE, &id) == HSR_ENOTFOUND);
+    CHECK(pick(h, 15, 15, HSR_PICK_VISIBLE) == t);
+    CHECK(pick(h, 15, 15, HSR_PICK_NEXT_BEHIND) == o);
+    CHECK(pick(h, 15, 15, HSR_PICK_FIRST_OPAQUE) == o);
+    CHECK(pick(h, 25, 25, HSR_PICK_FIRST_OPAQUE) == NO_HIT);
+    CHECK(pick(h, 5, 5, HSR_PICK_VISIBLE) == o);
+    CHECK(pick(h, 100, 100, HSR_PICK_VISIBLE) == NO_HIT);
     int nv;
     CHECK(hsr_mlr_get(h, t, NULL, NULL, NULL, &nv, NULL) && nv == 2);
     CHECK_NEAR(t_visible_area(h, t), 400, 1e-12);
     CHECK(hsr_set_opacity(h, t, 1.0) == HSR_OK);
-    CHECK(hsr_pick(h, 15, 15, HSR_PICK_NEXT_BEHIND, &id) == HSR_OK && id == o);
+    CHECK(pick(h, 15, 15, HSR_PICK_NEXT_BEHIND) == o);
     CHECK(hsr_mlr_get(h, t, NULL, NULL, NULL, &nv, NULL) && nv == 1);
     CHECK(llr_count(h) == 2 && hsr_check(h) == HSR_OK);
     CHECK(hsr_set_opacity(h, o, 0.25) == HSR_OK && hsr_check(h) == HSR_OK);
-    CHECK(hsr_pick(h, 5, 5, HSR_PICK_FIRST_OPAQUE, &id) == HSR_ENOTFOUND);
+    CHECK(pick(h, 5, 5, HSR_PICK_FIRST_OPAQUE) == NO_HIT);
     hsr_destroy(h);
 }
 
@@ -158,9 +167,8 @@ static void test_hsr_interpenetrating_squares(void)
     int b = t_add_rect(h, 10, 10, 30, 30, 0, 0, 1);
     CHECK_NEAR(t_visible_area(h, a), 350, 1e-12);
     CHECK_NEAR(t_visible_area(h, b), 350, 1e-12);
-    int id;
-    CHECK(hsr_pick(h, 14, 15, HSR_PICK_VISIBLE, &id) == HSR_OK && id == a);
-    CHECK(hsr_pick(h, 16, 15, HSR_PICK_VISIBLE, &id) == HSR_OK && id == b);
+    CHECK(pick(h, 14, 15, HSR_PICK_VISIBLE) == a);
+    CHECK(pick(h, 16, 15, HSR_PICK_VISIBLE) == b);
     CHECK(hsr_check(h) == HSR_OK);
     hsr_destroy(h);
 }
