@@ -768,6 +768,12 @@ int main(int argc, char** argv) {
     rin.rst = true;
     for (int k = 0; k < 4; ++k) fa->step(rin);
     for (uint64_t i = 0; i < ffwd; ++i) fast_step(i);
+    // The pieces made their own context the thread's current one. Make it the flat
+    // model's again before anything can return: a Verilated scope unregisters from the
+    // thread's current context when destroyed, so returning with a piece's context current
+    // left ~Vde_array locking the mutex of a context already freed with the fast array
+    // (the harness printed its error and hung instead of exiting).
+    Verilated::threadContextp(ctx.get());
     long copied = 0;
     if (!hand_over(*fa, *ctx, *top, n_chips, true, copied, err)) {
       std::fprintf(stderr, "%s: %s\n", argv[0], err.c_str());
@@ -780,7 +786,6 @@ int main(int argc, char** argv) {
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - f0).count(),
                  copied);
   }
-  // The pieces made their own context the thread's current one.
   Verilated::threadContextp(ctx.get());
   // After a window with nothing to watch beyond it, the rest runs in the fast array again.
   const uint64_t back_at = (fa && o.repeat == 1 && (!o.fst.empty() || !o.csv.empty()) &&
