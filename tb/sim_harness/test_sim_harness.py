@@ -62,9 +62,14 @@ def stream_on_disk(stream, tmp_path):
     return harness_exe(), src, trace.Timing.of(slots, CHIPS)
 
 
+# A harness run here takes seconds; one that has not ended after this long hangs (an
+# error path once printed its message and then hung in a destructor for 36 minutes).
+RUN_TIMEOUT_S = 600
+
+
 def run(exe, src, dst, *args, rc=0) -> subprocess.CompletedProcess:
     res = subprocess.run([str(exe), str(src), str(dst), *map(str, args)],
-                         capture_output=True, text=True)
+                         capture_output=True, text=True, timeout=RUN_TIMEOUT_S)
     assert res.returncode == rc, res.stderr + res.stdout
     return res
 
