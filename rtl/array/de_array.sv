@@ -17,7 +17,10 @@ module de_array
   parameter int unsigned CarryBug  = 0,
   parameter int unsigned NumPe     = 9,    // PEs per chip (the source's chip has 9)
   // Test only: chip c's PE i is faulty when bit c*NumPe+i is set (bypass test).
-  parameter logic [1023:0] FaultMask = '0
+  parameter logic [1023:0] FaultMask = '0,
+  // de_chip TimingCopies: 0 leaves out the timing-only register copies (the Verilated
+  // harnesses, sim/Makefile); no output changes.
+  parameter int unsigned TimingCopies = 1
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
@@ -78,7 +81,8 @@ module de_array
     de_chip #(
       .NumPe    (NumPe),
       .CarryBug (CarryBug),
-      .FaultMask(32'(FaultMask[c*NumPe +: NumPe]))
+      .FaultMask(32'(FaultMask[c*NumPe +: NumPe])),
+      .TimingCopies(TimingCopies)
     ) u_chip (
       .clk_i, .rst_i,
       .link_i     (link_c[c]),

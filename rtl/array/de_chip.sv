@@ -27,7 +27,12 @@ module de_chip
   // Test only: PEs whose bus output is corrupted (bit i = PE i), to show bypass works.
   parameter logic [31:0] FaultMask = '0,
   // Timing only: copies of the reset on rst_i (a reset tree, below); 1 = one reset.
-  parameter int unsigned RstW      = 1
+  parameter int unsigned RstW      = 1,
+  // Timing only: 1 = the fast form's kept register copies (the identifier for the next
+  // PE's operand selects, the pixel-valid bit for the collision flag); they hold the
+  // values of the registers they copy, so 0 changes no output. The FPGA builds and the
+  // testbenches keep 1; the Verilated harnesses build 0 (the copies cost them 11 %).
+  parameter int unsigned TimingCopies = 1
 ) (
   input  logic             clk_i,
   // Synchronous, active high: RstW registered copies of ONE reset, equal in every cycle.
@@ -72,13 +77,13 @@ module de_chip
   link_t core_link;
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask),
-                 .RstW(RstW))
+                 .RstW(RstW), .TimingCopies(TimingCopies))
   u_core (
     .clk_i, .rst_i, .link_i, .blk1z_i, .idsel_i, .chain_ctl_i, .chain_i, .chain_o,
     .bypass_o, .link_o(core_link)
   );
 
-  de_chip_bound #(.IdCopy((Compact == 1) ? 0 : 1)) u_bound (
+  de_chip_bound #(.IdCopy((Compact == 0 && TimingCopies == 1) ? 1 : 0)) u_bound (
     .clk_i, .rst_i(rst_i[(5 * NumPe + 1) % RstW]), .link_i(core_link), .link_o, .blk1z_o,
     .idsel_o
   );
@@ -96,7 +101,8 @@ module de_chip_core
   parameter int unsigned CarryBug  = 0,
   parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
   parameter logic [31:0] FaultMask = '0,
-  parameter int unsigned RstW      = 1    // copies of the reset (de_chip)
+  parameter int unsigned RstW      = 1,   // copies of the reset (de_chip)
+  parameter int unsigned TimingCopies = 1   // de_chip
 ) (
   input  logic             clk_i,
   /* verilator lint_off UNUSEDSIGNAL */
@@ -178,7 +184,8 @@ module de_chip_core
 
     logic [IdW-1:0]   pe_idsel;
     de_pe #(.CarryBug(CarryBug), .Compact(Compact), .RstW(PeRstW),
-            .IdCopy((Compact == 1) ? 0 : 1), .PixCopy((Compact == 1) ? 0 : 1)) u_pe (
+            .IdCopy((Compact == 0 && TimingCopies == 1) ? 1 : 0),
+            .PixCopy((Compact == 0 && TimingCopies == 1) ? 1 : 0)) u_pe (
       .clk_i,
       .rst_i      (pe_rst[i]),
       .bypass_i   (pe_byp[i]),

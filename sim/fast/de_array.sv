@@ -12,7 +12,9 @@ module de_array
   parameter int unsigned NumChips  = 72,
   parameter int unsigned CarryBug  = 0,
   parameter int unsigned NumPe     = 9,
-  parameter logic [1023:0] FaultMask = '0
+  parameter logic [1023:0] FaultMask = '0,
+  // The pieces are built without the timing-only copies (de_chip TimingCopies = 0).
+  parameter int unsigned TimingCopies = 0
 ) (
   input  logic             clk_i,
   input  logic             rst_i,

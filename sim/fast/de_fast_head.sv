@@ -35,7 +35,7 @@ module de_fast_head
     else       skew_blk1z_q <= (data_i[BlkW +: BlkW] == '0);
   end
 
-  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug)) u_core (
+  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .TimingCopies(0)) u_core (
     .clk_i, .rst_i, .link_o, .chain_o,
     .link_i     (skew_link),
     .blk1z_i    (skew_blk1z_q),

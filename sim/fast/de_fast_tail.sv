@@ -22,9 +22,10 @@ module de_fast_tail
   logic [IdW-1:0] b_idsel;  // likewise
   /* verilator lint_on UNUSEDSIGNAL */
 
-  // IdCopy as in de_chip (the fast form): the trace build's fast-forward copies every
-  // register of the flat de_array's last boundary, its identifier copy included, here.
-  de_chip_bound #(.IdCopy(1)) u_bound (.clk_i, .rst_i, .link_i, .link_o(b_link),
+  // No identifier copy: the pieces are built as de_chip with TimingCopies = 0, and so is
+  // the trace build's flat de_array (sim/Makefile), whose fast-forward copies every
+  // register of its last boundary here by name.
+  de_chip_bound #(.IdCopy(0)) u_bound (.clk_i, .rst_i, .link_i, .link_o(b_link),
                                        .blk1z_o(b_blk1z), .idsel_o(b_idsel));
 
   de_deskew u_deskew (

@@ -21,16 +21,18 @@ module de_fast_unit
 );
   link_t b_link;
   logic  b_blk1z;
-  logic [IdW-1:0] b_idsel;  // timing only: chip c-1's copy of its id register
+  // Timing only: with IdCopy = 0 the boundary passes its id register itself (the pieces
+  // are built as de_chip with TimingCopies = 0, as the trace build's flat de_array is).
+  logic [IdW-1:0] b_idsel;
   /* verilator lint_off UNUSEDSIGNAL */
   logic [NumPe-1:0] bypass;
   /* verilator lint_on UNUSEDSIGNAL */
 
-  de_chip_bound #(.IdCopy(1)) u_bound (.clk_i, .rst_i, .link_i, .link_o(b_link),
+  de_chip_bound #(.IdCopy(0)) u_bound (.clk_i, .rst_i, .link_i, .link_o(b_link),
                                        .blk1z_o(b_blk1z), .idsel_o(b_idsel));
   assign prev_coll_o = b_link.coll;
 
-  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug)) u_core (
+  de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .TimingCopies(0)) u_core (
     .clk_i, .rst_i, .link_o, .chain_ctl_i, .chain_i, .chain_o,
     .link_i     (b_link),
     .blk1z_i    (b_blk1z),
