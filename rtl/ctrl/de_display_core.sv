@@ -57,10 +57,9 @@ module de_display_core #(
   output logic                                 align_err_o   // sticky: blank low, no pixel
 );
 
-  // Parameter checks at elaboration (the sub-blocks check their own ranges too).
-  if (NumBuf < 1 || NumBuf > 8) begin : g_bad_numbuf
-    $fatal(1, "de_display_core: NumBuf must be 1..8");
-  end
+  // Parameter checks at elaboration. NumBuf (1..8) is checked where it is used, by
+  // de_access_ctrl and de_load_monitor, which take it unchanged; the core adds the one
+  // bound of its own, ArrayLatency >= 1.
   if (ArrayLatency < 1 || ArrayLatency > 4095) begin : g_bad_latency
     $fatal(1, "de_display_core: ArrayLatency must be 1..4095");
   end
