@@ -52,15 +52,9 @@ module tb_board_sdram #(
   );
 
   // The SDRAM chip behind the board's DQ pins.
-  logic [3:0]  err_code;
-  logic [31:0] cycle;
   sdram_sdr16_pins #(.TckPs(8000), .TinitNs(SdTinitNs)) u_sdram (
-    .clk_i(clk_sdram_i), .rst_i, .sd_i(sd), .dq_o(bus),
-    .err_count_o, .err_code_o(err_code), .ref_count_o, .cycle_o(cycle)
+    .clk_i(clk_sdram_i), .rst_i, .sd_i(sd), .dq_o(bus), .err_count_o, .ref_count_o
   );
-
-  logic unused;
-  assign unused = ^{err_code, cycle};
 endmodule
 
 `default_nettype wire

@@ -210,10 +210,10 @@ if cocotb is not None:
         assert mal >= min(255, n_mal_period * (n_frames // 2)), (
             f"malformed lines {mal}, want >= {n_mal_period} per two frames")
         assert int(dut.late_o.value) == 0
-        assert int(dut.err_count_o.value) == 0, "SDRAM timing violations"
-        assert int(dut.ref_count_o.value) > 0, "no refresh seen"
+        assert int(dut.u_sdram.err_count_o.value) == 0, "SDRAM timing violations"
+        assert int(dut.u_sdram.ref_count_o.value) > 0, "no refresh seen"
         dut._log.info(f"malformed lines counted {mal}; SDRAM refreshes "
-                      f"{int(dut.ref_count_o.value)}, 0 violations")
+                      f"{int(dut.u_sdram.ref_count_o.value)}, 0 violations")
 
 
 # ====================================================================== pytest runners
