@@ -102,3 +102,45 @@ def chunks(seed: int, n_commands: int, width: int, per_line: tuple[int, int] = (
             out = []
     if out:
         yield out
+
+
+# ---- raw slot streams ---------------------------------------------------------------------
+
+SOUP_IDS = (isa.NOP, isa.REFRESH, isa.ACCMODE_ON, isa.ACCMODE_OFF, isa.ADDR_RANGE,
+            isa.ADDR_PERIODIC, isa.ADDR_EVAL0, isa.ADDR_DIS, isa.ACC, isa.D_A, isa.D_B,
+            isa.D_C, isa.D_B_C, isa.D_A_B, isa.D_A_B_NP, isa.D_A_A_NP, isa.SET_A, isa.SET_B,
+            isa.SET_C)
+SOUP_WEIGHTS = (2, 2, 1, 1, 6, 3, 3, 3, 6) + (4,) * 7 + (2, 2, 2)
+
+
+def undefined_pair(prev: int, ident: int) -> bool:
+    """A data slot right behind an ACC or an Eval0 address slot: no command makes either
+    sequence, and docs/isa.md section 6 ("Undefined") leaves both undefined (the PE reads
+    the protect flags in the data slot's first stage, a clock before the ACC / Eval0
+    clears them in its second)."""
+    return prev in (isa.ACC, isa.ADDR_EVAL0) and bool(ident & isa.ID_DATA)
+
+
+def slot_soup(seed: int, count: int, width: int) -> list[tuple[int, int]]:
+    """Raw slots of the 19 atomic instructions in any order, for a `width`-column array:
+    orphan data and ACC slots, address slots with no data, Refreshes back to back, X and
+    dX at and past the end. Draws `count` slots, drops the undefined pairs
+    (undefined_pair) and ends with a Refresh."""
+    rng = random.Random(seed)
+    slots: list[tuple[int, int]] = []
+    for _ in range(count):
+        ident = rng.choices(SOUP_IDS, SOUP_WEIGHTS)[0]
+        if ident & isa.ID_ADDR:
+            x = rng.choice([0, rng.randrange(width), width - 1, width + rng.randrange(3)])
+            dx = rng.choice([0, 1, rng.randrange(1, width + 4), rng.randrange(4096)])
+            data = x | dx << 12 | rng.randrange(4096) << 24
+        elif ident & isa.ID_DATA:
+            data = rng.randrange(1 << 36) if rng.random() < 0.3 else \
+                isa.to_word(rng.randrange(-8 * ONE, 8 * ONE))
+        else:
+            data = 0
+        if slots and undefined_pair(slots[-1][0], ident):
+            continue
+        slots.append((ident, data))
+    slots.append((isa.REFRESH, 0))
+    return slots
