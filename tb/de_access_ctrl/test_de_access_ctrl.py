@@ -6,7 +6,10 @@
 * test_fair_rr: with 1..NumBuf backlogged buffers the grant rotates exactly.
 * test_random_vs_model: random y-processor traffic (underload and overload) against a
   cycle-exact Python model of the controller: bus contents, grants, discards, late
-  flags, ready strobes.
+  flags, ready strobes. The underload regime stays within HTotal - 2 slots a line and
+  must have no late buffer and no drop.
+* test_line_capacity: a line of HTotal - 2 command slots over all buffers is on time,
+  one of HTotal - 1 makes exactly one buffer late (its marker misses the window).
 
 The seed is printed; SEED=<n> replays.
 """
@@ -223,19 +226,28 @@ def make_cmd(rng, max_len=5):
 
 
 async def run_vs_model(dut, rng, n_cycles, feed_p, cmds_per_line, pre_lines=0,
-                       check=None):
-    """Drive Python buffers fed with whole commands; compare DUT with Model every cycle."""
+                       line_budget=None):
+    """Drive Python buffers fed with whole commands; compare DUT with Model every cycle.
+    line_budget: at most this many command slots per active line summed over all buffers
+    (a drawn command that would pass it is left out of the line)."""
     nb = int(dut.NumBuf.value)
-    await reset(dut, 3)
-    model = Model(nb, TEST_MODE)
     bufs = [deque() for _ in range(nb)]
     # Per-buffer y-processor: list of pending commands (lists of words), lines end in a
     # marker command.
     pending = [deque() for _ in range(nb)]
+    n_lines = [0] * nb       # lines generated so far, per buffer
+    used = {}                # active line index -> command slots given to it so far
 
     def new_line(i):
+        k = n_lines[i]
+        n_lines[i] += 1
         for _ in range(rng.randint(*cmds_per_line)):
-            pending[i].append(make_cmd(rng))
+            cmd = make_cmd(rng)
+            if line_budget is not None:
+                if used.get(k, 0) + len(cmd) > line_budget:
+                    continue
+                used[k] = used.get(k, 0) + len(cmd)
+            pending[i].append(cmd)
         pending[i].append([MARKER | rng.getrandbits(12)])
 
     for i in range(nb):
@@ -243,14 +255,28 @@ async def run_vs_model(dut, rng, n_cycles, feed_p, cmds_per_line, pre_lines=0,
             new_line(i)
             while pending[i]:
                 bufs[i].extend(pending[i].popleft())
-    exp = None
-    log = []
-    for _ in range(n_cycles):
+
+    def feed():
         for i in range(nb):
             if not pending[i]:
                 new_line(i)
             if rng.random() < feed_p:
                 bufs[i].extend(pending[i].popleft())
+
+    return await drive_vs_model(dut, bufs, n_cycles, feed)
+
+
+async def drive_vs_model(dut, bufs, n_cycles, feed=None):
+    """Reset to the test mode, then drive `bufs` (one deque of words per buffer; `feed()`
+    tops them up before every cycle) and compare every output with Model each cycle."""
+    nb = int(dut.NumBuf.value)
+    await reset(dut, 3)
+    model = Model(nb, TEST_MODE)
+    exp = None
+    log = []
+    for _ in range(n_cycles):
+        if feed is not None:
+            feed()
         dut.buf_valid_i.value = sum((len(b) > 0) << i for i, b in enumerate(bufs))
         dut.buf_data_i.value = sum((b[0] if b else 0) << (48 * i) for i, b in enumerate(bufs))
         await ReadOnly()
@@ -331,12 +357,20 @@ async def test_random_vs_model(dut):
     stats = []
     # (feed probability per cycle, offered load in windows, lines preloaded); a command
     # averages 2.5 slots, so load L means about L * (ht - 1) / 2.5 commands per line.
+    # Regime 0 is underload by construction, not just on average: the draw is up to
+    # cpl[1] commands of up to 5 slots per buffer and line (40 slots for NumBuf 8, about
+    # 1 seed in 60 drew a line over the window), so its lines get a budget of
+    # HTotal - 2 slots over all buffers, the most a window can carry with every marker
+    # delivered in it (docs/display-controller.md §2.1; test_line_capacity). Its feed
+    # (p = 0.5 a cycle, two lines preloaded, at most two items a line consumed against
+    # about 12 fed) keeps every buffer lines ahead, so no buffer can be late there.
     for k, (feed_p, load, pre) in enumerate([(0.5, 0.4, 2), (0.9, 1.6, 1),
                                              (0.05, 0.6, 0), (1.0, 3.0, 3)]):
         rng = random.Random(seed + k)
         per_buf = load * (ht - 1) / 2.5 / nb
         cpl = (0, max(1, round(2 * per_buf)))
-        log = await run_vs_model(dut, rng, frames * vt * ht, feed_p, cpl, pre)
+        log = await run_vs_model(dut, rng, frames * vt * ht, feed_p, cpl, pre,
+                                 line_budget=ht - 2 if k == 0 else None)
         issued = sum(g["ev_issue"] for g in log)
         drops = sum(bin(g["drop"]).count("1") for g in log)
         lates = sum(bin(g["ev_late"]).count("1") for g in log)
@@ -346,6 +380,55 @@ async def test_random_vs_model(dut):
     assert stats[3][1] > 0, "overload (discard) never exercised"
     assert all(s[0] > 0 for s in stats), "a regime issued nothing"
     assert stats[0][1] == 0, "underload regime dropped instructions"
+    assert stats[0][2] == 0, "a buffer was late in the underload regime"
+
+
+def _line_stream(nb, lens, owners):
+    """Buffers holding active line 0 (commands of `lens` slots, command j in buffer
+    owners[j]) and then empty lines 1..5 (markers only)."""
+    bufs = [deque() for _ in range(nb)]
+    for j, (n, i) in enumerate(zip(lens, owners)):
+        if n == 1:
+            bufs[i].append((isa.ADDR_EVAL0 << W) | j)
+        else:
+            ids = [isa.ADDR_RANGE] + [isa.D_A] * (n - 2) + [isa.ACC]
+            bufs[i].extend((ident << W) | j for ident in ids)
+    for i in range(nb):
+        bufs[i].extend([MARKER] * TEST_MODE["va"])
+    return bufs
+
+
+@cocotb.test()
+async def test_line_capacity(dut):
+    """A window takes HTotal - 2 command slots on time over all buffers, not HTotal - 1."""
+    cocotb.start_soon(Clock(dut.clk_i, PERIOD_NS, unit="ns").start())
+    nb = int(dut.NumBuf.value)
+    ht, vt = totals(TEST_MODE)
+    # The blank lines (line 0's window is the last one's), then lines 0..5: one frame.
+    n_cycles = vt * ht + 2
+    # One-slot commands spread over the buffers, and a mix ending in a 5-slot command.
+    mixes = {"1-slot": lambda total: [1] * total,
+             "mixed": lambda total: [3, 2, 4, 1] * ((total - 5) // 10)
+             + [1] * ((total - 5) % 10) + [5]}
+    for name, mix in mixes.items():
+        for total, late_expected in ((ht - 2, 0), (ht - 1, 1)):
+            lens = mix(total)
+            assert sum(lens) == total
+            bufs = _line_stream(nb, lens, [j % nb for j in range(len(lens))])
+            log = await drive_vs_model(dut, bufs, n_cycles)
+            issued = sum(g["ev_issue"] for g in log)
+            lates = sum(bin(g["ev_late"]).count("1") for g in log)
+            drops = sum(bin(g["drop"]).count("1") for g in log)
+            assert issued == total, f"{name}, {total} slots: issued {issued}"
+            # Late with HTotal - 1: the bus is busy in every slot of the window, so the
+            # buffer whose command takes the last slot has its marker at the head only
+            # at the Refresh; nothing else of its line is left, so only that marker is
+            # discarded and no word is dropped.
+            assert lates == late_expected, f"{name}, {total} slots: {lates} late buffers"
+            assert drops == 0, f"{name}, {total} slots: {drops} dropped"
+            assert all(not b for b in bufs), f"{name}, {total} slots: buffers not drained"
+    dut._log.info("line capacity HTotal - 2 = %d slots on time, HTotal - 1 late (%d buffers)",
+                  ht - 2, nb)
 
 
 def _build_and_run(num_buf: int, latency: int, all_modes: bool):
