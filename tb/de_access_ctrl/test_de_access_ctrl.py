@@ -56,6 +56,12 @@ def now() -> int:
     return int(get_sim_time("ns")) // PERIOD_NS
 
 
+def start_clock(dut):
+    """Start the clock; return NumBuf and the test mode's totals (HTotal, VTotal)."""
+    cocotb.start_soon(Clock(dut.clk_i, PERIOD_NS, unit="ns").start())
+    return int(dut.NumBuf.value), *totals(TEST_MODE)
+
+
 async def reset(dut, mode: int):
     from common.run import hold_reset
     await hold_reset(dut, 3, falling=False, mode_i=mode, buf_valid_i=0, buf_data_i=0)
@@ -305,9 +311,7 @@ async def drive_vs_model(dut, bufs, n_cycles, feed=None):
 @cocotb.test()
 async def test_fair_rr(dut):
     """1..NumBuf backlogged buffers: the grant rotates one command at a time."""
-    cocotb.start_soon(Clock(dut.clk_i, PERIOD_NS, unit="ns").start())
-    nb = int(dut.NumBuf.value)
-    ht, vt = totals(TEST_MODE)
+    nb, ht, vt = start_clock(dut)
     for n_active in range(1, nb + 1):
         for cmd_len in (1, 3):
             await reset(dut, 3)
@@ -348,11 +352,9 @@ async def test_fair_rr(dut):
 @cocotb.test()
 async def test_random_vs_model(dut):
     """Random traffic, underload and overload, cycle-exact against the model."""
-    cocotb.start_soon(Clock(dut.clk_i, PERIOD_NS, unit="ns").start())
+    nb, ht, vt = start_clock(dut)
     seed = get_seed()
     dut._log.info("SEED=%d (set SEED=%d to replay)", seed, seed)
-    nb = int(dut.NumBuf.value)
-    ht, vt = totals(TEST_MODE)
     frames = 6
     stats = []
     # (feed probability per cycle, offered load in windows, lines preloaded); a command
@@ -401,9 +403,7 @@ def _line_stream(nb, lens, owners):
 @cocotb.test()
 async def test_line_capacity(dut):
     """A window takes HTotal - 2 command slots on time over all buffers, not HTotal - 1."""
-    cocotb.start_soon(Clock(dut.clk_i, PERIOD_NS, unit="ns").start())
-    nb = int(dut.NumBuf.value)
-    ht, vt = totals(TEST_MODE)
+    nb, ht, vt = start_clock(dut)
     # The blank lines (line 0's window is the last one's), then lines 0..5: one frame.
     n_cycles = vt * ht + 2
     # One-slot commands spread over the buffers, and a mix ending in a 5-slot command.
