@@ -586,9 +586,21 @@ def seeds_report(args, seed_list, need, per_seed, factor, floor) -> dict:
             "need": need, "margin_pct": args.margin if factor else None,
             "target_mhz": floor,
             "command": f"python3 fpga/scripts/flow.py seeds --design {args.design} "
-                       f"--seeds {args.seeds}" + "".join(
-                           f" --pnr-arg='{a}'" for a in (getattr(args, "pnr_arg", None) or [])),
+                       f"--seeds {args.seeds}" + trial_options(args),
             "per_seed": per_seed, "summary": summary, "pass": ok}
+
+
+def trial_options(args) -> str:
+    """The chip options of a run that differ from the committed ones, as flow.py takes
+    them (so a trial report's command line repeats the trial)."""
+    if args.design != "chip":
+        return ""
+    opts = ""
+    if args.freq != 200.0:
+        opts += f" --freq {args.freq:g}"
+    if args.timing_weight != CHIP_TIMING_WEIGHT:
+        opts += f" --timing-weight {args.timing_weight}"
+    return opts + "".join(f" --pnr-arg='{a}'" for a in (args.pnr_arg or []))
 
 
 def seeds_text(rep: dict) -> str:

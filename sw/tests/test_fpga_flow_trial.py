@@ -52,6 +52,13 @@ def test_pnr_args_are_split_on_blanks_after_the_timing_weight(flow):
                                         "--placer", "static", "--tmg-ripup"]
 
 
+def test_a_trial_report_repeats_its_options(flow):
+    args = chip_args(seeds="1", freq=155.0, timing_weight=30, pnr_arg=["--placer static"])
+    assert flow.trial_options(args) == " --freq 155 --timing-weight 30 --pnr-arg='--placer static'"
+    assert flow.trial_options(chip_args()) == ""
+    assert flow.trial_options(chip_args(design="board")) == ""
+
+
 @pytest.mark.parametrize("sub", [[], ["seeds"], ["pe"], ["chip"], ["array-fit"], ["frames"]])
 def test_every_subcommand_answers_help(sub):
     r = subprocess.run([sys.executable, str(FLOW), *sub, "--help"], capture_output=True,
