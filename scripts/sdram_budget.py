@@ -29,9 +29,11 @@ H_TOTAL, V_ACTIVE, V_TOTAL = 800, 480, 525
 
 
 def words_per_line(path: Path) -> list[int]:
-    """One frame-store word per bus slot: the slots of each line, its marker included."""
-    sys.path.insert(0, str(ROOT / "scripts"))
-    from bench_span import slots_per_line
+    """One frame-store word per bus slot: the slots of each line, its marker included
+    (make bench-span's count, diffengine.bench.span)."""
+    if str(ROOT / "sw") not in sys.path:
+        sys.path.insert(0, str(ROOT / "sw"))
+    from diffengine.bench.span import slots_per_line
     return slots_per_line(path)
 
 
