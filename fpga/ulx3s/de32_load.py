@@ -153,6 +153,9 @@ def read_image(path: str, window: int | None, rnd: bool) -> Image:
 
 def scene_files(paths: list[str]) -> list[str]:
     """The r, g, b files of a scene: a directory's r/g/b .de32 or .de48, or three files."""
+    for p in paths:
+        if not Path(p).exists():
+            raise LoadError(f"{p}: no such file or directory")
     if len(paths) == 1 and Path(paths[0]).is_dir():
         d = Path(paths[0])
         files = []

@@ -264,6 +264,9 @@ def test_bad_inputs_name_file(tmp_path, capsys, monkeypatch):
     Path(files[1]).write_bytes(Path(files[1]).read_bytes()[:-2])
     assert dl.main(["/nonexistent", *files]) == 1
     assert f"{files[1]}:byte 22: truncated" in capsys.readouterr().err
+    # A scene that is not there: named (was "give a scene directory or three files").
+    assert dl.main(["/nonexistent", str(tmp_path / "no_scene")]) == 1
+    assert f"{tmp_path / 'no_scene'}: no such file or directory" in capsys.readouterr().err
     # A .de48 value below the window's grid: an error naming file and slot, unless --round.
     from diffengine import isa
     sl = isa.serialise([isa.Command("EVAL", 1, 2, (3, 1 << 20)), isa.Command("REFRESH")])
