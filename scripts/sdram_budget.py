@@ -12,6 +12,10 @@ late. The smallest D with no late line, over two frames starting from full FIFOs
 vertical blanking, is the depth the colour needs.
 
     scripts/sdram_budget.py [--scenes teapot,cad] [--rates 2.460,2.375,1.538] [--burst 4]
+                            [--fetch]
+
+--fetch adds the depth for the fetchers' real read pattern on frames stored as tables of
+lines (fetch_bursts: table bursts, blocks read in whole bursts, pads), not plain streams.
 
 A rate is words per pixel clock: f_sdram x efficiency / 2 beats per word / 25 MHz.
 """
@@ -29,16 +33,41 @@ H_TOTAL, V_ACTIVE, V_TOTAL = 800, 480, 525
 
 
 def words_per_line(path: Path) -> list[int]:
-    """One frame-store word per bus slot: the slots of each line, its marker included."""
-    sys.path.insert(0, str(ROOT / "scripts"))
-    from bench_span import slots_per_line
+    """One frame-store word per bus slot: the slots of each line, its marker included
+    (make bench-span's count, diffengine.bench.span)."""
+    if str(ROOT / "sw") not in sys.path:
+        sys.path.insert(0, str(ROOT / "sw"))
+    from diffengine.bench.span import slots_per_line
     return slots_per_line(path)
 
 
+def fetch_bursts(lines_c: list[int], burst: int, fetch: bool) -> list[tuple[int, int]]:
+    """One colour's frame as the SDRAM serves it, per burst (words into the FIFO, words on
+    the bus). Plain: the stream in bursts of `burst` words. `fetch`: as de_frame_fetch
+    reads a frame stored as a table of lines (fpga/ulx3s/frame_pack.py): a table burst
+    (no FIFO words) ahead of every `burst` lines, each line's block in ceil(len / burst)
+    bursts (the words past the line's end are read and dropped), and a line that is only
+    its marker as a pad (one FIFO word, no SDRAM read)."""
+    if not fetch:
+        return [(burst, burst)]
+    out = []
+    for v, n in enumerate(lines_c):
+        if v % burst == 0:
+            out.append((0, burst))
+        if n == 1:
+            out.append((1, 0))
+            continue
+        out += [(min(burst, n - k), burst) for k in range(0, n, burst)]
+    return out
+
+
 def late_lines(lines: list[list[int]], rate: float, burst: int, depth: int,
-               frames: int = 2) -> int:
-    """Late lines over `frames` frames with per-colour FIFOs of `depth` words."""
+               frames: int = 2, fetch: bool = False) -> int:
+    """Late lines over `frames` frames with per-colour FIFOs of `depth` words; `fetch`:
+    the fetchers' read pattern (fetch_bursts) instead of plain streams."""
     nc = len(lines)
+    seq = [fetch_bursts(c, burst, fetch) for c in lines]
+    pos = [0] * nc
     fifo = [depth] * nc                 # full: prefetched during vertical blanking
     credit = 0.0
     rr = 0
@@ -50,13 +79,15 @@ def late_lines(lines: list[list[int]], rate: float, burst: int, depth: int,
             want = [lines[c][nxt] if nxt < V_ACTIVE else 0 for c in range(nc)]
             for h in range(H_TOTAL):
                 credit += rate
-                while credit >= burst:
+                while True:
                     for k in range(nc):
                         c = (rr + k) % nc
-                        if fifo[c] + burst <= depth:
-                            fifo[c] += burst
+                        fw, bw = seq[c][pos[c] % len(seq[c])]
+                        if fifo[c] + fw <= depth and bw <= credit:
+                            fifo[c] += fw
+                            credit -= bw
+                            pos[c] += 1
                             rr = (c + 1) % nc
-                            credit -= burst
                             break
                     else:
                         credit = min(credit, float(burst))   # all full: the SDRAM idles
@@ -71,15 +102,15 @@ def late_lines(lines: list[list[int]], rate: float, burst: int, depth: int,
     return late
 
 
-def min_depth(lines, rate, burst) -> int:
+def min_depth(lines, rate, burst, fetch: bool = False) -> int:
     lo, hi = burst, 1 << 16
-    if late_lines(lines, rate, burst, hi):
+    if late_lines(lines, rate, burst, hi, fetch=fetch):
         return -1
     while lo < hi:
         mid = (lo + hi) // 2
         mid -= mid % burst
         mid = max(mid, lo)
-        if late_lines(lines, rate, burst, mid):
+        if late_lines(lines, rate, burst, mid, fetch=fetch):
             lo = mid + burst
         else:
             hi = mid
@@ -93,12 +124,16 @@ def main() -> int:
     # Measured by tb/de_sdram_ctrl at 125 MHz; 95 % of 125 MHz; 78.125 MHz at 98.4 %.
     ap.add_argument("--rates", default="2.460,2.375,1.538")
     ap.add_argument("--burst", type=int, default=4)
+    ap.add_argument("--fetch", action="store_true",
+                    help="also the depth with the fetchers' read pattern: a table burst per "
+                         "4 lines, each line's block in whole bursts, marker-only lines as pads")
     a = ap.parse_args()
     subprocess.run(["make", "-s", "-C", "sw/yproc", "build/yproc"], cwd=ROOT, check=True)
     tmp = Path(tempfile.mkdtemp(prefix="sdram_budget_"))
     print("| scene | words/line per colour mean / max | 3 colours: max line, words | "
-          "rate, words/pixel clock | FIFO depth per colour, words |")
-    print("|---|---|---|---|---|")
+          "rate, words/pixel clock | FIFO depth per colour, words |"
+          + (" the same, fetch pattern |" if a.fetch else ""))
+    print("|---|---|---|---|---|" + ("---|" if a.fetch else ""))
     for name in a.scenes.split(","):
         d = tmp / name
         d.mkdir()
@@ -108,9 +143,11 @@ def main() -> int:
         tot = [sum(c[v] for c in lines) for v in range(V_ACTIVE)]
         stats = " / ".join(f"{sum(c) / len(c):.0f}-{max(c)}" for c in lines)
         for rate in (float(r) for r in a.rates.split(",")):
-            dep = min_depth(lines, rate, a.burst)
-            print(f"| {name} | {stats} | {max(tot)} | {rate:.3f} | "
-                  f"{dep if dep >= 0 else 'none (average exceeds the rate)'} |", flush=True)
+            deps = [min_depth(lines, rate, a.burst, f) for f in ((False, True) if a.fetch
+                                                                   else (False,))]
+            print(f"| {name} | {stats} | {max(tot)} | {rate:.3f} | " + " | ".join(
+                f"{d if d >= 0 else 'none (average exceeds the rate)'}" for d in deps) + " |",
+                flush=True)
     return 0
 
 

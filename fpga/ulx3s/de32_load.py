@@ -151,7 +151,11 @@ def read_image(path: str, window: int | None, rnd: bool) -> Image:
     raise LoadError(f"{path}:byte 0: neither .de32 nor .de48 (docs/formats.md)")
 
 
-def read_scene(paths: list[str], window, rnd) -> list[Image]:
+def scene_files(paths: list[str]) -> list[str]:
+    """The r, g, b files of a scene: a directory's r/g/b .de32 or .de48, or three files."""
+    for p in paths:
+        if not Path(p).exists():
+            raise LoadError(f"{p}: no such file or directory")
     if len(paths) == 1 and Path(paths[0]).is_dir():
         d = Path(paths[0])
         files = []
@@ -164,35 +168,61 @@ def read_scene(paths: list[str], window, rnd) -> list[Image]:
         paths = files
     if len(paths) != 3:
         raise LoadError("give a scene directory or three files: red green blue")
-    return [read_image(p, window, rnd) for p in paths]
+    return list(paths)
+
+
+def read_scene(paths: list[str], window, rnd) -> list[Image]:
+    return [read_image(p, window, rnd) for p in scene_files(paths)]
+
+
+def anim_dir(d: str) -> Path:
+    """The directory holding frame000/ and the deltas: `make anim`'s out/anim keeps them
+    in streams/ (diffengine anim), `yproc anim -o DIR` in DIR itself."""
+    p = Path(d)
+    if not (p / "frame000").is_dir() and (p / "streams" / "frame000").is_dir():
+        p = p / "streams"
+    if not (p / "frame000").is_dir():
+        raise LoadError(f"{d}: no frame000/ nor streams/frame000/ (make anim writes "
+                        "out/anim/streams)")
+    return p
+
+
+def anim_files(d: str, n: int) -> list[list[str]]:
+    """[f][c]: the file each frame's colour comes from (frame 0's .de48, then the delta)."""
+    p = anim_dir(d)
+    return [[str(p / "frame000" / f"{c}.de48") if f == 0 else str(p / f"frame{f:03d}.delta")
+             for c in "rgb"] for f in range(n)]
 
 
 def read_anim(d: str, window, rnd) -> list[list[Image]]:
     from diffengine.pipeline import anim
     if window is None:
         raise LoadError(f"{d}: an animation's .de48 streams need --window (0..4)")
-    if not (Path(d) / "frame000").is_dir():
-        raise LoadError(f"{d}: no frame000/ (make anim writes out/anim)")
+    p = anim_dir(d)
     try:
-        seq = anim.frames(d)
+        seq = anim.frames(p)
     except ValueError as e:
-        raise LoadError(str(e)) from None
-    return [[de48_image(anim.to_de48(ch), f"{d}/frame{f:03d} {'rgb'[c]}", window, rnd)
+        raise LoadError(f"{p}: {e}") from None
+    return [[de48_image(anim.to_de48(ch), f"{p}/frame{f:03d} {'rgb'[c]}", window, rnd)
              for c, ch in enumerate(fr)] for f, fr in enumerate(seq)]
 
 
 # ---------------------------------------------------------------------------- the plan
 def plan_packets(frames: list[list[Image]], words: int, shift: int, sat: bool,
                  region_bits: int = 21, hold: int = 1, show: int | None = None,
-                 loop: bool = True):
+                 loop: bool = True, names: list[list[str]] | None = None):
     """Every packet in order ('X' runs of at most `words` words, 'F' per frame and
-    colour, 'Q', 'O'), and the frame_pack.Plan they come from."""
+    colour, 'Q', 'O'), and the frame_pack.Plan they come from. names[f][c]: the file
+    frame f's colour c came from, named first in a packer error."""
     import frame_pack
     lines = sum(1 for w in frames[0][0][0] if frame_pack.is_marker(w))
     try:
         plan = frame_pack.pack(frames, lines, hold=hold, loop=loop and len(frames) > 1,
                                region_words=1 << region_bits)
     except frame_pack.PackError as e:
+        f, c = getattr(e, "frame", None), getattr(e, "colour", None)
+        if names is not None and f is not None and c is not None:
+            raise LoadError(f"{names[f][c]}: {e}") from None
         raise LoadError(str(e)) from None
     pkts = []
     for ch, off, ws in plan.writes:
@@ -422,11 +452,14 @@ def main(argv=None, port_fd: int | None = None) -> int:
         print(f"de32_load: --hold {a.hold} outside 1..255", file=sys.stderr)
         return 1
     try:
-        frames = []
+        frames, names = [], []
         if a.scene:
             frames.append(read_scene(a.scene, a.window, a.round))
+            names.append(scene_files(a.scene))
         if a.anim:
-            frames += read_anim(a.anim, a.window, a.round)
+            seq = read_anim(a.anim, a.window, a.round)
+            frames += seq
+            names += anim_files(a.anim, len(seq))
         port = Port(port_fd if port_fd is not None else a.port, a.baud)
         loader = Loader(port, a.retries, a.abandon,
                         log=lambda m: print(f"\nde32_load: {m}", file=sys.stderr))
@@ -440,7 +473,7 @@ def main(argv=None, port_fd: int | None = None) -> int:
                                     "bitstream (make fpga-board)")
                 region_bits = st[3]
             pkts, plan = plan_packets(frames, a.words, a.shift, not a.nosat, region_bits,
-                                      a.hold, a.show, not a.no_loop)
+                                      a.hold, a.show, not a.no_loop, names)
             state = State(a.state, plan_hash(pkts), len(pkts))
             start = state.load() if a.resume else 0
             if start == len(pkts):

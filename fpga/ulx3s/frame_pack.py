@@ -55,7 +55,10 @@ MARKER_WORD = MARKER_INDEX << binfmt.OPERAND_BITS   # the canonical marker (oper
 
 
 class PackError(ValueError):
-    """A frame that cannot be packed; the message names frame, colour and line."""
+    """A frame that cannot be packed; the message names frame, colour and line, and
+    `frame` / `colour` (indices, None if none) say which input it was."""
+    frame: int | None = None
+    colour: int | None = None
 
 
 def is_marker(word: int) -> bool:
@@ -213,40 +216,45 @@ def pack(frames, vactive: int, *, first_slot: int = 0, hold: int = 1,
             raise PackError(f"frame {f}: {len(fr)} colours, want 3 (r, g, b)")
         row = []
         for c, img in enumerate(fr):
-            words, window, comp = _fields(img)
-            where = f"frame {f} colour {COLOURS[c]} "
-            if not 0 <= window <= 4:
-                raise PackError(f"{where}: window {window} outside 0..4")
-            st = plan.colour_stats[c]
-            st.words_referenced += len(words)
-            st.lines_referenced += vactive
-            run_off, run = nxt[c], []
-            ents = []
-            for y, line in enumerate(split_lines(words, vactive, where)):
-                if line == (MARKER_WORD,):
-                    ents.append(entry(0, 0))
-                    st.empty_lines += 1
-                    continue
-                if len(line) > MAX_LEN:
-                    raise PackError(f"{where}line {y}: {len(line)} words, a block holds at "
-                                    f"most {MAX_LEN} (marker included)")
-                off = blocks[c].get(line)
-                if off is None:
-                    off = blocks[c][line] = append(c, line, f"{where}line {y}", "block")
-                    st.blocks_stored += 1
-                    st.block_words += len(line)
-                ents.append(entry(off // ALIGN, len(line)))
-            key = tuple(ents)
-            toff = tables[c].get(key)
-            if toff is None:
-                toff = tables[c][key] = append(c, ents, f"{where}line {vactive - 1}",
-                                               "frame table")
-                st.tables_stored += 1
-            if run:
-                plan.writes.append((c, run_off, run))
-            st.words_used = nxt[c]
-            plan.slots.append((c, first_slot + f, toff, window, comp))
-            row.append(toff)
+            try:
+                words, window, comp = _fields(img)
+                where = f"frame {f} colour {COLOURS[c]} "
+                if not 0 <= window <= 4:
+                    raise PackError(f"{where.rstrip()}: window {window} outside 0..4")
+                st = plan.colour_stats[c]
+                st.words_referenced += len(words)
+                st.lines_referenced += vactive
+                run_off, run = nxt[c], []
+                ents = []
+                for y, line in enumerate(split_lines(words, vactive, where)):
+                    if line == (MARKER_WORD,):
+                        ents.append(entry(0, 0))
+                        st.empty_lines += 1
+                        continue
+                    if len(line) > MAX_LEN:
+                        raise PackError(f"{where}line {y}: {len(line)} words, a block holds at "
+                                        f"most {MAX_LEN} (marker included)")
+                    off = blocks[c].get(line)
+                    if off is None:
+                        off = blocks[c][line] = append(c, line, f"{where}line {y}", "block")
+                        st.blocks_stored += 1
+                        st.block_words += len(line)
+                    ents.append(entry(off // ALIGN, len(line)))
+                key = tuple(ents)
+                toff = tables[c].get(key)
+                if toff is None:
+                    toff = tables[c][key] = append(c, ents, f"{where}line {vactive - 1}",
+                                                   "frame table")
+                    st.tables_stored += 1
+                if run:
+                    plan.writes.append((c, run_off, run))
+                st.words_used = nxt[c]
+                plan.slots.append((c, first_slot + f, toff, window, comp))
+                row.append(toff)
+            except PackError as e:
+                if e.frame is None:
+                    e.frame, e.colour = f, c
+                raise
         plan.tables.append(row)
     if loop is None:
         loop = len(frames) > 1
@@ -293,10 +301,8 @@ def load_inputs(paths: list[str], window: int, rnd: bool) -> list:
     frames = []
     for p in paths:
         d = Path(p)
-        if (d / "streams" / "frame000").is_dir():
-            d = d / "streams"
-        if (d / "frame000").is_dir():
-            frames += de32_load.read_anim(str(d), window, rnd)
+        if (d / "frame000").is_dir() or (d / "streams" / "frame000").is_dir():
+            frames += de32_load.read_anim(str(d), window, rnd)   # finds streams/ itself
         else:
             frames.append(de32_load.read_scene([str(d)], window, rnd))
     return frames

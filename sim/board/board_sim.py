@@ -124,6 +124,24 @@ def host_packets(plan: frame_pack.Plan) -> list[bytes]:
             + [de32_load.cmd_q(*plan.sequence)])
 
 
+def sequence_check(res: dict, n_frames: int, hold: int, want: int):
+    """The harness's frames (stats.json) against the sequence: from the first frame that is
+    not black, slot k for `hold` frames each, and at least `want` of them (the harness
+    stops after want + 8 frames in all, so a sequence that starts late shows fewer).
+    Returns (live frames, golden index of each, the index expected, errors)."""
+    first = res["first_live_frame"]
+    live = list(res["frames"][first:]) if first >= 0 else []
+    order = [f["golden"] for f in live]
+    expect = [(k // hold) % n_frames for k in range(len(live))]
+    errors = list(res["errors"])
+    if order != expect:
+        errors.append(f"frames shown {order}, want the sequence {expect}")
+    if len(live) < want:
+        errors.append(f"{len(live)} frame(s) of the sequence shown (from decoded frame "
+                      f"{first}), want {want}")
+    return live, order, expect, errors
+
+
 # ---------------------------------------------------------------------------- one case
 def run_case(case: str, a, exe: Path) -> dict:
     out = Path(a.out) / case
@@ -158,13 +176,7 @@ def run_case(case: str, a, exe: Path) -> dict:
     if r.returncode == 2 or not (out / "stats.json").exists():
         return {"case": case, "ok": False, "errors": [f"harness exit status {r.returncode}"]}
     res = json.loads((out / "stats.json").read_text())
-    # The order: from the first live frame, slot k of the sequence for `hold` frames each.
-    live = [f for f in res["frames"][res["first_live_frame"]:]] if res["first_live_frame"] >= 0 else []
-    order = [f["golden"] for f in live]
-    expect = [(k // plan.sequence[2]) % len(frames) for k in range(len(live))]
-    errors = list(res["errors"])
-    if order != expect:
-        errors.append(f"frames shown {order}, want the sequence {expect}")
+    live, order, expect, errors = sequence_check(res, len(frames), plan.sequence[2], want)
     dec = np.fromfile(out / "frames.rgb", dtype=np.uint8)
     dec = dec.reshape(-1, HEIGHT, WIDTH, 3) if dec.size else dec.reshape(0, HEIGHT, WIDTH, 3)
     for k, (f, img) in enumerate(zip(live, dec)):

@@ -11,7 +11,8 @@ Python (no simulator):
     with too few / too many lines or words after its last marker (errors naming frame,
     colour and line), more than 64 frames;
   * the preload file round trip (write_image / read_image_file) and the CLI (--help,
-    --stats on a .de32 scene directory).
+    --stats on a .de32 scene directory);
+  * `make anim`'s 36 frames (yproc anim of cad_drag) fit the regions, sharing lines.
 SEED=<n> replays the random streams.
 """
 from __future__ import annotations
@@ -251,3 +252,56 @@ def test_cli(tmp_path):
     r = subprocess.run([sys.executable, tool, str(scene), "--vactive", "479"],
                        capture_output=True, text=True)
     assert r.returncode == 1 and "frame 0 colour r line 479: more than 479" in r.stderr
+
+
+def test_make_anim_fits(tmp_path):
+    """`make anim`'s 36 frames (sw/scenes/anim/cad_drag.anim, `yproc anim` as `make anim`
+    and board_sim run it) packed at window 2, rounded (de32_load.py --window 2 --round):
+    they fit each colour's 2^21-word region, sharing lines (docs/board-frames.md §1:
+    1.11-1.12 M words, 53 %; 1.77 M without sharing), one slot each, looping; frames read
+    back through their tables equal the tool's conversion of their streams. Each distinct
+    line is converted once (the conversion is per slot, so a frame's words are its lines'
+    words in order; checked on frame 0 against de32_load's whole-stream conversion)."""
+    sys.path.insert(0, str(ROOT / "fpga" / "ulx3s"))
+    import de32_load
+    from diffengine.pipeline import anim
+
+    subprocess.run(["make", "-s", "-C", str(ROOT / "sw" / "yproc"), "build/yproc"], check=True)
+    r = subprocess.run([str(ROOT / "sw/yproc/build/yproc"), "anim",
+                        str(ROOT / "sw/scenes/anim/cad_drag.anim"), "-o", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    seq = anim.frames(tmp_path)
+    assert len(seq) == 36
+    cache: dict[bytes, list[int]] = {}
+
+    def words(lines, name):
+        out = []
+        for ln in lines:
+            if ln not in cache:
+                cache[ln] = de32_load.de48_image(anim.to_de48([ln]), name, 2, True)[0]
+            out += cache[ln]
+        return out
+
+    frames = [[(words(fr[c], f"frame {f} {'rgb'[c]}"), 2, False) for c in range(3)]
+              for f, fr in enumerate(seq)]
+    for c in range(3):
+        whole = de32_load.de48_image(anim.to_de48(seq[0][c]), "frame 0", 2, True)[0]
+        assert frames[0][c][0] == whole
+    plan = fp.pack(frames, 480)
+    assert plan.fits()
+    assert plan.sequence == (0, 36, 1, 1)
+    assert len(plan.slots) == 3 * 36
+    for c, st in enumerate(plan.stats()):
+        print(f"colour {'rgb'[c]}: {st['words_used']:,} words used "
+              f"({100 * st['words_used'] / fp.REGION_WORDS:.1f} %), "
+              f"{st['words_referenced']:,} referenced, {st['blocks_stored']:,} blocks, "
+              f"{st['tables_stored']} tables")
+        assert st["fits"] and st["words_used"] <= fp.REGION_WORDS
+        assert st["lines_referenced"] == 36 * 480
+        assert st["words_used"] < 0.7 * st["words_referenced"], "lines are shared"
+        assert st["blocks_stored"] < 36 * 480 // 2
+    img = plan.image()
+    for f in (0, 1, 15, 20, 35):
+        for c in range(3):
+            assert fp.read_back(img, c, plan.tables[f][c], 480) == frames[f][c][0], (f, c)

@@ -207,11 +207,16 @@ def _line(rng, w):
     return b"".join((i << 36 | d).to_bytes(6, "big") for i, d in isa.serialise(cmds))
 
 
-def test_scene_dir_and_anim(tmp_path):
+@pytest.mark.parametrize("layout", ["yproc", "make_anim"])
+def test_scene_dir_and_anim(tmp_path, layout):
+    """layout yproc: `yproc anim -o DIR` (frame000/ and the deltas in DIR); make_anim:
+    `make anim`'s out/anim, which keeps them in out/anim/streams/ and is what the
+    documented command (docs/board.md §3.3) gives --anim."""
     from diffengine.formats import binfmt
     rng = random.Random(seed())
     w, h = 2, 5
-    f0 = tmp_path / "anim" / "frame000"
+    streams = tmp_path / "anim" / ("streams" if layout == "make_anim" else "")
+    f0 = streams / "frame000"
     f0.mkdir(parents=True)
     lines = [[_line(rng, w) for _ in range(h)] for _ in range(3)]
     for c, ch in enumerate("rgb"):
@@ -224,7 +229,7 @@ def test_scene_dir_and_anim(tmp_path):
         d += struct.pack(">I", len(ch))
         for y, words in ch.items():
             d += struct.pack(">HI", y, len(words) // 6) + words
-    (tmp_path / "anim" / "frame001.delta").write_bytes(bytes(d))
+    (streams / "frame001.delta").write_bytes(bytes(d))
 
     m = LoaderModel()
     dev, path, slave = board(m)
@@ -259,6 +264,9 @@ def test_bad_inputs_name_file(tmp_path, capsys, monkeypatch):
     Path(files[1]).write_bytes(Path(files[1]).read_bytes()[:-2])
     assert dl.main(["/nonexistent", *files]) == 1
     assert f"{files[1]}:byte 22: truncated" in capsys.readouterr().err
+    # A scene that is not there: named (was "give a scene directory or three files").
+    assert dl.main(["/nonexistent", str(tmp_path / "no_scene")]) == 1
+    assert f"{tmp_path / 'no_scene'}: no such file or directory" in capsys.readouterr().err
     # A .de48 value below the window's grid: an error naming file and slot, unless --round.
     from diffengine import isa
     sl = isa.serialise([isa.Command("EVAL", 1, 2, (3, 1 << 20)), isa.Command("REFRESH")])
@@ -283,7 +291,7 @@ def test_bad_inputs_name_file(tmp_path, capsys, monkeypatch):
     write_de32(Path(files[2]), line_words(rng, 6, 3))
     assert dl.main([path, *files, "--state", str(st), *FAST]) == 1
     err = capsys.readouterr().err
-    assert "frame 0 colour b line 2" in err, err
+    assert f"{files[2]}: frame 0 colour b line 2" in err, err
     # A board with the version-1 loader (block-RAM frame stores): refused, named.
     write_de32(Path(files[2]), line_words(rng, 6, 2))
     import loader_model
