@@ -75,12 +75,15 @@ def test_make_lists_are_the_cores(directory, var, args, makefile, expect):
 
 # Single RTL files a tool may still name (a one-module unit test, a substitution); a file
 # that names two or more RTL sources outside comments and docstrings keeps a list by hand.
-ALLOWED = {
-    "scripts/lint.sh": "case patterns of the loop over rtl/board/*.sv, not a list",
-}
+# A shell `case` pattern (`*/de_uart_pkg.sv) ;;`, scripts/lint.sh's loop over
+# rtl/board/*.sv) selects a file, it lists none; a brace expansion
+# (`de_uart_{rx,tx}.sv`) names every file it expands to.
+ALLOWED: dict[str, str] = {}
 TOOL_GLOBS = ["Makefile", "sim/**/Makefile", "sim/**/*.mk", "fpga/**/Makefile",
               "fpga/**/*.sh", "fpga/**/*.ys", "fpga/**/*.py", "scripts/*.sh", "scripts/*.py",
-              "tb/**/*.py"]
+              "tb/**/*.py", "tb/**/*.sby"]
+CASE_PATTERN = re.compile(r"^\s*[\w.*/|]+\)")
+BRACES = re.compile(r"(\w*)\{([\w,]+)\}(\w*)\.sv\b")
 
 
 def _rtl_names_in(path: Path, rtl: set[str]) -> set[str]:
@@ -96,6 +99,10 @@ def _rtl_names_in(path: Path, rtl: set[str]) -> set[str]:
                    and isinstance(n.value, str) and id(n) not in docs]
     else:
         strings = [line.split("#", 1)[0] for line in text.splitlines()]
+        if path.suffix == ".sh":
+            strings = [CASE_PATTERN.sub("", s) for s in strings]
+        strings = [BRACES.sub(lambda m: " ".join(f"{m[1]}{x}{m[3]}.sv" for x in m[2].split(",")), s)
+                   for s in strings]
     return {m for s in strings for m in re.findall(r"(\w+\.sv)\b", s) if m in rtl}
 
 
