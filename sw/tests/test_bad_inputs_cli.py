@@ -7,6 +7,7 @@ it: `yproc hsr/scan/read/anim`, and `diffengine reference/compare` (which read s
 through `yproc read`), `diffengine asm/disasm/model` for command files. The message must
 start with `FILE:LINE: ` (or `FILE: ` where no line exists: a file that cannot be opened
 is named by the line that refers to it when there is one) and the status must be 1.
+`diffengine sim --manifest` (make sim's TOML manifest) is held to the same rule.
 test_obj_features.py holds the OBJ/MTL readers' individual messages; this file holds the
 paths from the command line to them.
 """
@@ -144,3 +145,28 @@ def test_diffengine_command_files_name_file_and_line(tmp_path):
         r = de(*args)
         assert r.returncode == 1, (args, r.stderr)
         assert msg in _first_line(r.stderr), (args, r.stderr)
+
+
+MANIFESTS = [
+    ("toml_syntax", '[[file]]\npaths = ["sw/scenes/fig7_25.cmd"]\nchips [2]\n',
+     "m.toml:3: Expected '=' after a key"),
+    ("missing_field", '# c\n[[file]]\npaths = ["sw/scenes/fig7_25.cmd"]\nchips = [2]\n\n[[random]]\n'
+     'seeds = [1]\n',
+     "m.toml:6: [[random]] has no 'chips'"),
+    ("no_match", '[[file]]\npaths = ["sw/scenes/fig7_25.cmd"]\nchips = [2]\n[[file]]\n'
+     'paths = ["sw/scenes/nothere_*.cmd"]\nchips = [2]\n',
+     "m.toml:4: [[file]] 'sw/scenes/nothere_*.cmd' matches no file"),
+    ("bad_tier", '[[carry]]\nseeds = [1]\nchips = [2]\ntier = "weekly"\n',
+     "m.toml:1: [[carry]] tier 'weekly' not in"),
+]
+
+
+@pytest.mark.parametrize("name,text,msg", MANIFESTS, ids=[m[0] for m in MANIFESTS])
+def test_sim_manifest_names_file_and_line(tmp_path, name, text, msg):
+    """`diffengine sim --manifest` (make sim's TOML): an error names the file and line."""
+    (tmp_path / "m.toml").write_text(text)
+    r = subprocess.run([sys.executable, "-m", "diffengine", "sim", "--manifest",
+                        str(tmp_path / "m.toml"), "--list", "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert _first_line(r.stderr).startswith(f"sim: {tmp_path}/{msg}"), r.stderr
