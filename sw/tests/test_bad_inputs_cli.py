@@ -170,3 +170,14 @@ def test_sim_manifest_names_file_and_line(tmp_path, name, text, msg):
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 1, r.stdout + r.stderr
     assert _first_line(r.stderr).startswith(f"sim: {tmp_path}/{msg}"), r.stderr
+
+
+def test_sim_durations_file_names_file_and_line(tmp_path):
+    """A corrupt durations file (--shard's recorded case times) names file and line."""
+    (tmp_path / "d.json").write_text('{"seconds": {\n  "a": 1.0,\n  "b": \n}}\n')
+    r = subprocess.run([sys.executable, "-m", "diffengine", "sim", "--tier", "smoke",
+                        "--shard", "1/2", "--durations", str(tmp_path / "d.json"), "--list",
+                        "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert _first_line(r.stderr).startswith(f"sim: {tmp_path}/d.json:4: Expecting value"), r.stderr

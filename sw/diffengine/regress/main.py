@@ -90,7 +90,11 @@ def command(a) -> int:
     out = a.out
     if shard:
         k, n = shard
-        recorded = load_durations(durations)
+        try:
+            recorded = load_durations(durations)
+        except ValueError as e:
+            print(f"sim: {e}", file=sys.stderr)
+            return 1
         cases = assign_shards(cases, n, recorded)[k - 1]
         out = shard_dir(a.out, k, n)
         est = estimates(cases, recorded)
