@@ -30,12 +30,10 @@ for f in rtl/board/*.sv; do
   case $f in
     */de_board_core.sv) ;;
     */de_frame_player.sv) lint_top de_frame_player $(files input) "$f" ;;
-    */de_sdram_frames.sv) lint_top de_sdram_frames $(files sdram_ctrl) \
-        $(files prim) rtl/board/de_frame_fetch.sv $(files input) \
-        rtl/board/de_frame_player.sv "$f" ;;
+    */de_sdram_frames.sv) lint_top de_sdram_frames $(files board frames) ;;
     */de_uart_pkg.sv|*/de_sdram_pkg.sv) ;;   # linted with their users
     */de_sdram_ctrl.sv) lint_top de_sdram_ctrl $(files sdram_ctrl) ;;
-    */de_uart_link.sv) lint_top de_uart_link rtl/board/de_uart_{pkg,rx,tx}.sv "$f" ;;
+    */de_uart_link.sv) lint_top de_uart_link $(files board uart) ;;
     *) lint_top "$(basename "$f" .sv)" "$f" ;;
   esac
 done

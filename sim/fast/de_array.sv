@@ -6,6 +6,8 @@
 // ports. Built instead of rtl/array/de_array.sv by the fast harness builds only
 // (sim/Makefile, sim/dc/Makefile with FAST=1); sim/fast/equiv.cpp checks the two against
 // each other every cycle.
+`default_nettype none
+
 module de_array
   import de_pkg::*;
 #(
@@ -69,3 +71,5 @@ module de_array
   end
   assign n_pe_o = 16'(NumChips * NumPe);
 endmodule
+
+`default_nettype wire

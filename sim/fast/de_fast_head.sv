@@ -2,6 +2,8 @@
 // the chips' boundary registers. de_skew feeds chip 0's core directly, exactly as in
 // rtl/array/de_array.sv; chip 0's boundary register lives in the next piece.
 // Simulation wiring only: every register and gate comes from the RTL modules.
+`default_nettype none
+
 module de_fast_head
   import de_pkg::*;
 #(
@@ -45,3 +47,5 @@ module de_fast_head
     .bypass_o   (bypass)
   );
 endmodule
+
+`default_nettype wire

@@ -2,6 +2,8 @@
 // the chips' boundary registers = the last chip's boundary register, de_deskew and the
 // sticky collision flag, exactly as in rtl/array/de_array.sv.
 // Simulation wiring only: every register and gate comes from the RTL modules.
+`default_nettype none
+
 module de_fast_tail
   import de_pkg::*;
 (
@@ -44,3 +46,5 @@ module de_fast_tail
   end
   assign pix_collision_o = coll_q;
 endmodule
+
+`default_nettype wire

@@ -4,6 +4,8 @@
 // compiled model serves every chip 1..NumChips-1 and its evaluation never depends
 // combinationally on what another piece computes in the same cycle.
 // Simulation wiring only: every register and gate comes from the RTL modules.
+`default_nettype none
+
 module de_fast_unit
   import de_pkg::*;
 #(
@@ -40,3 +42,5 @@ module de_fast_unit
     .bypass_o   (bypass)
   );
 endmodule
+
+`default_nettype wire

@@ -1,4 +1,6 @@
 """Binary formats, deserialisation and the frame-store data mapper (docs/isa.md §8)."""
+import random
+
 import pytest
 from hypothesis import given, settings, strategies as st
 
@@ -275,3 +277,20 @@ def test_load_commands_detects_kind():
     mapped, info = binfmt.load_commands(de32, "a")
     assert info == ("de32", 0, True)
     assert mapped[0].values == (isa.compensate(1 << 24),)
+
+
+def test_word_blocks_are_the_isa_split():
+    """isa.word_blocks / blocks_word: the one place the 36-bit word is cut into its 12-bit
+    blocks in Python (binfmt, disasm, trace and the inspector use them; de_pkg::word_blk is
+    the RTL's)."""
+    w = 0x123_456_789
+    assert isa.word_blocks(w) == (0x789, 0x456, 0x123)
+    assert isa.blocks_word((0x789, 0x456, 0x123)) == w
+    assert isa.block_bits(0) == (isa.BLOCK_BITS - 1, 0)
+    assert isa.block_bits(isa.BLOCKS - 1) == (isa.WORD_BITS - 1, isa.WORD_BITS - isa.BLOCK_BITS)
+    rng = random.Random(17)
+    for _ in range(200):
+        w = rng.randrange(1 << isa.WORD_BITS)
+        b = isa.word_blocks(w)
+        assert len(b) == isa.BLOCKS and all(0 <= x <= isa.BLOCK_MASK for x in b)
+        assert isa.blocks_word(b) == w

@@ -107,7 +107,7 @@ def deserialise(slots, filename: str = "<slots>") -> list[Command]:
         ident, data = slots[i]
         if ident not in isa.ID_NAME:
             fail(i, f"unknown identifier {ident:#05x}")
-        b0, b1, b2 = (data & isa.BLOCK_MASK, (data >> 12) & isa.BLOCK_MASK, data >> 24)
+        b0, b1, b2 = isa.word_blocks(data)
         if ident in _SIMPLE or ident in (isa.ACCMODE_ON, isa.ACCMODE_OFF):
             if data:
                 fail(i, f"{name(ident)} carries nonzero data {isa.format_fixed(data)}")
@@ -190,7 +190,7 @@ def map_word(word: int, window: int, compensate: bool = False) -> tuple[int, int
         return ident, 0
     if typ == isa.TYPE_ADDR:
         pixel = (_sext(operand >> 20, 7) << window) & isa.BLOCK_MASK
-        return ident, (operand & 0x3FF) | ((operand >> 10) & 0x3FF) << 12 | pixel << 24
+        return ident, isa.blocks_word((operand & 0x3FF, (operand >> 10) & 0x3FF, pixel))
     value = _sext(operand, OPERAND_BITS) << (4 + window)
     if compensate:
         value = isa.compensate(value)
@@ -203,7 +203,7 @@ def _fs_operand(ident: int, data: int, window: int) -> int:
     if typ == isa.TYPE_NONE:
         return 0
     if typ == isa.TYPE_ADDR:
-        b0, b1, b2 = data & isa.BLOCK_MASK, (data >> 12) & isa.BLOCK_MASK, data >> 24
+        b0, b1, b2 = isa.word_blocks(data)
         names = ("dX", "X") if ident == isa.ADDR_PERIODIC else ("X", "dX")
         for n, v in zip(names, (b0, b1)):
             if v > FS_ADDR_MAX:

@@ -32,7 +32,7 @@ def list_slots(slots) -> str:
         name = isa.ID_NAME.get(ident, "?")
         text = f"{i:6d}  {ident:#05x}  {name:<13} {isa.format_fixed(data)}"
         if isa.ID_TYPE.get(ident) == isa.TYPE_ADDR:
-            text += (f"  [b2={data >> 24} b1={(data >> 12) & isa.BLOCK_MASK}"
-                     f" b0={data & isa.BLOCK_MASK}]")
+            b0, b1, b2 = isa.word_blocks(data)
+            text += f"  [b2={b2} b1={b1} b0={b0}]"
         rows.append(text)
     return "\n".join(rows) + ("\n" if rows else "")

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 from ._tables import *  # noqa: F401,F403 (generated from spec/isa.toml)
 from ._tables import (
     ACC, ACCMODE_OFF, ACCMODE_ON, ADDR_DIS, ADDR_EVAL0, ADDR_MAX, ADDR_PERIODIC,
-    ADDR_RANGE, BLOCK_BITS, BLOCK_MASK, D_A, D_A_A_NP, D_A_B, D_A_B_NP, D_B, D_B_C, D_C,
-    DST_SHIFT, FRAC_BITS, FRAC_MASK, ID_DATA, ID_PROT, ID_SET, LUT, MAX_EVAL_ORDER,
+    ADDR_RANGE, BLOCK_BITS, BLOCK_MASK, BLOCKS, D_A, D_A_A_NP, D_A_B, D_A_B_NP, D_B, D_B_C,
+    D_C, DST_SHIFT, FRAC_BITS, FRAC_MASK, ID_DATA, ID_PROT, ID_SET, LUT, MAX_EVAL_ORDER,
     NOP, REFRESH, REG_A, REG_B, REG_C, REG_NONE, SET_A, SET_B, SET_C, SRC_SHIFT,
     TYPE_ADDR, TYPE_INT, TYPE_NONE, WORD_BITS, WORD_MASK, add_word,
 )
@@ -63,6 +63,22 @@ def format_fixed(word: int) -> str:
 def pixel_of(word: int) -> int:
     """The 12-bit pixel a D register shows: its integer part, raw (wraps)."""
     return (word >> FRAC_BITS) & BLOCK_MASK
+
+
+def word_blocks(word: int) -> tuple[int, ...]:
+    """A 36-bit word as its BLOCKS blocks of BLOCK_BITS, block 0 (the least significant)
+    first: the split the PE's adder and the skewed bus make (de_pkg::word_blk)."""
+    return tuple((word >> (BLOCK_BITS * j)) & BLOCK_MASK for j in range(BLOCKS))
+
+
+def blocks_word(blocks) -> int:
+    """The inverse of word_blocks: blocks, block 0 first, back into one word."""
+    return sum((int(b) & BLOCK_MASK) << (BLOCK_BITS * j) for j, b in enumerate(blocks))
+
+
+def block_bits(j: int) -> tuple[int, int]:
+    """(msb, lsb) of block j in the word, for messages."""
+    return BLOCK_BITS * j + BLOCK_BITS - 1, BLOCK_BITS * j
 
 
 def compensate(value: int, literal: bool = False) -> int:

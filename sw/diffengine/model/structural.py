@@ -24,7 +24,7 @@ from .. import isa
 
 BLK = isa.BLOCK_BITS
 M = isa.BLOCK_MASK
-N_BLK = 3
+N_BLK = isa.BLOCKS
 
 # Register indices in Array.R (index 0 is the "none" operand: always zero, never written).
 R_NONE, R_A, R_B, R_C, R_D = 0, 1, 2, 3, 4
@@ -71,6 +71,16 @@ class Array:
             raise ValueError("n_pe must be >= 1")
         self.n = int(n_pe)
         self.bug = bool(carry_bug)
+        # The carry fault as spec/isa.toml [adder] gives it (de_pkg::blk_carry_in): the
+        # registered carry into the block that holds bit ADD_CARRY_FROM enters it at bit
+        # ADD_CARRY_TO - ADD_CARRY_FROM instead of bit 0. Only into the top block: below
+        # it the weighted carry could carry 2 out, which a one-bit block carry cannot hold
+        # (de_pe refuses the same, g_bad_carry_blk).
+        fault_blk, off = divmod(isa.ADD_CARRY_FROM, BLK)
+        if off or fault_blk != N_BLK - 1:
+            raise ValueError(f"structural: the carry fault must enter the top block at a block "
+                             f"boundary, got ADD_CARRY_FROM = {isa.ADD_CARRY_FROM}")
+        self.cin2_weight = 1 << (isa.ADD_CARRY_TO - isa.ADD_CARRY_FROM) if self.bug else 1
         self.reset()
 
     # ---- state -----------------------------------------------------------------
@@ -137,11 +147,11 @@ class Array:
         n = self.n
         idx = np.arange(n)
         R, P = self.R, self.P
-        cin2_weight = 2 if self.bug else 1  # the §7.7 fault: block-1 carry lands on bit 25
+        cin2_weight = self.cin2_weight  # the §7.7 fault (spec/isa.toml; __init__)
 
         # PE inputs: PE 0 from the array input (+ skew), PE p from PE p-1's registers.
         in_id = np.empty(n, dtype=np.int64)
-        in_id[0] = ident & 0xFFF
+        in_id[0] = ident & isa.ID_MASK
         in_id[1:] = self.id1[:-1]
         inb = np.empty((N_BLK, n), dtype=np.int64)
         inb[0, 0] = data & M

@@ -48,19 +48,55 @@ def _safe(text: str) -> str:
     return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in text)
 
 
+class ManifestError(ValueError):
+    """A manifest that cannot be read or expanded; the message starts `FILE:LINE: `."""
+
+
+def _entry_lines(text: str) -> dict[str, list[int]]:
+    """Line of each `[[kind]]` table header, per kind, in order (tomllib keeps no
+    positions; an entry's errors are reported at its header)."""
+    lines: dict[str, list[int]] = {}
+    for n, ln in enumerate(text.splitlines(), 1):
+        head = ln.split("#", 1)[0].strip()
+        if head.startswith("[[") and head.endswith("]]"):
+            lines.setdefault(head[2:-2].strip(), []).append(n)
+    return lines
+
+
 def load_manifest(path: Path = MANIFEST, tier: str = "full") -> list[Case]:
-    """Expand the manifest into cases for `tier` (tiers are cumulative)."""
+    """Expand the manifest into cases for `tier` (tiers are cumulative). ManifestError
+    (naming the file and the line of the entry) for a manifest that does not parse, an
+    entry without a field it needs, an unknown tier, a path pattern that matches nothing."""
     if tier not in TIERS:
         raise ValueError(f"tier {tier!r}: want one of {', '.join(TIERS)}")
     rank = TIERS.index(tier)
-    doc = tomllib.loads(Path(path).read_text())
+    text = Path(path).read_text()
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:   # "... (at line L, column C)"
+        msg, _, at = str(e).rpartition(" (at line ")
+        line = at.split(",")[0] if at else "?"
+        raise ManifestError(f"{path}:{line}: {msg or e}") from None
+    heads = _entry_lines(text)
     base = Path(path).resolve().parent
     cases: list[Case] = []
+    where = {id(e): (kind, i) for kind in ("file", "random", "carry", "chipcross", "scene")
+             for i, e in enumerate(doc.get(kind, []))}
+
+    def fail(entry, msg):
+        kind, i = where[id(entry)]
+        line = heads.get(kind, [])[i] if i < len(heads.get(kind, [])) else "?"
+        raise ManifestError(f"{path}:{line}: [[{kind}]] {msg}")
+
+    def need(entry, key):
+        if key not in entry:
+            fail(entry, f"has no {key!r}")
+        return entry[key]
 
     def wanted(entry) -> bool:
         t = entry.get("tier", "full")
         if t not in TIERS:
-            raise ValueError(f"{path}: tier {t!r} not in {TIERS}")
+            fail(entry, f"tier {t!r} not in {TIERS}")
         return TIERS.index(t) <= rank
 
     def add(case: Case, entry) -> None:
@@ -74,14 +110,14 @@ def load_manifest(path: Path = MANIFEST, tier: str = "full") -> list[Case]:
         if not wanted(e):
             continue
         files = []
-        for pat in e["paths"]:
+        for pat in need(e, "paths"):
             root = REPO if not pat.startswith(".") else base
             hits = sorted(root.glob(pat))
             if not hits:
-                raise ValueError(f"{path}: {pat!r} matches no file")
+                fail(e, f"{pat!r} matches no file")
             files += hits
         for f in files:
-            for chips in e["chips"]:
+            for chips in need(e, "chips"):
                 ref = e.get("reference")
                 add(Case(_safe(f"{f.stem}_c{chips}"), "file", chips,
                          str(f.relative_to(REPO)) if f.is_relative_to(REPO) else str(f),
@@ -91,8 +127,8 @@ def load_manifest(path: Path = MANIFEST, tier: str = "full") -> list[Case]:
         for e in doc.get(kind, []):
             if not wanted(e):
                 continue
-            for seed in e["seeds"]:
-                for chips in e["chips"]:
+            for seed in need(e, "seeds"):
+                for chips in need(e, "chips"):
                     p = {k: v for k, v in e.items() if k not in ("seeds", "chips", "tier",
                                                                  "bug_check", "bug_only")}
                     p["seed"] = seed
@@ -103,8 +139,8 @@ def load_manifest(path: Path = MANIFEST, tier: str = "full") -> list[Case]:
     for e in doc.get("scene", []):
         if not wanted(e):
             continue
-        scene = REPO / e["scene"]
-        for chips in e["chips"]:
+        scene = REPO / need(e, "scene")
+        for chips in need(e, "chips"):
             for ch in e.get("channels", ["r", "g", "b"]):
                 add(Case(_safe(f"scene_{scene.stem}_{ch}_c{chips}"), "scene", chips,
                          f"yproc scan {e['scene']} ({ch})",
@@ -114,7 +150,7 @@ def load_manifest(path: Path = MANIFEST, tier: str = "full") -> list[Case]:
     names = [c.name for c in cases]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
-        raise ValueError(f"{path}: duplicate case names {sorted(dup)}")
+        raise ManifestError(f"{path}: duplicate case names {sorted(dup)}")
     return cases
 
 

@@ -30,7 +30,7 @@ import sys
 from pathlib import Path
 
 from .. import REPO
-from .cases import MANIFEST, OUT, TIERS, load_manifest
+from .cases import MANIFEST, OUT, TIERS, ManifestError, load_manifest
 from .merge import is_complete, record_run, merge_main, save_frames, write_outputs
 from .run import run
 from .shards import RECORDING_TIERS, assign_shards, estimates, load_durations, parse_shard, shard_dir
@@ -77,7 +77,11 @@ def command(a) -> int:
     if a.merge:
         return merge_main(a.merge, a.out, a.durations, a.record_durations)
     shard = a.shard
-    cases = load_manifest(a.manifest, a.tier)
+    try:
+        cases = load_manifest(a.manifest, a.tier)
+    except ManifestError as e:
+        print(f"sim: {e}", file=sys.stderr)
+        return 1
     if a.pattern:
         cases = [c for c in cases if a.pattern in c.name or fnmatch.fnmatch(c.name, a.pattern)]
     if a.no_bug_checks:
@@ -86,7 +90,11 @@ def command(a) -> int:
     out = a.out
     if shard:
         k, n = shard
-        recorded = load_durations(durations)
+        try:
+            recorded = load_durations(durations)
+        except ValueError as e:
+            print(f"sim: {e}", file=sys.stderr)
+            return 1
         cases = assign_shards(cases, n, recorded)[k - 1]
         out = shard_dir(a.out, k, n)
         est = estimates(cases, recorded)

@@ -132,10 +132,11 @@ def slot_soup(seed: int, count: int, width: int) -> list[tuple[int, int]]:
         ident = rng.choices(SOUP_IDS, SOUP_WEIGHTS)[0]
         if ident & isa.ID_ADDR:
             x = rng.choice([0, rng.randrange(width), width - 1, width + rng.randrange(3)])
-            dx = rng.choice([0, 1, rng.randrange(1, width + 4), rng.randrange(4096)])
-            data = x | dx << 12 | rng.randrange(4096) << 24
+            blk = 1 << isa.BLOCK_BITS
+            dx = rng.choice([0, 1, rng.randrange(1, width + 4), rng.randrange(blk)])
+            data = isa.blocks_word((x, dx, rng.randrange(blk)))   # X, dX, Eval0 intensity
         elif ident & isa.ID_DATA:
-            data = rng.randrange(1 << 36) if rng.random() < 0.3 else \
+            data = rng.randrange(1 << isa.WORD_BITS) if rng.random() < 0.3 else \
                 isa.to_word(rng.randrange(-8 * ONE, 8 * ONE))
         else:
             data = 0

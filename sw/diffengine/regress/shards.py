@@ -52,7 +52,10 @@ def load_durations(path: Path = DURATIONS) -> dict[str, float]:
     path = Path(path)
     if not path.exists():
         return {}
-    doc = json.loads(path.read_text())
+    try:
+        doc = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}:{e.lineno}: {e.msg}") from None
     secs = doc.get("seconds", {}) if isinstance(doc, dict) else None
     if not isinstance(secs, dict):
         raise ValueError(f"{path}: want {{\"seconds\": {{case: seconds, ...}}}}")

@@ -39,7 +39,7 @@ FLAG_LETTERS = "ABCdlm"   # pA pB pC dis lock acc_mode (as `diffengine trace` pr
 
 def _words(R: np.ndarray, r: int) -> np.ndarray:
     b = R[r].astype(np.int64)
-    return b[0] | (b[1] << 12) | (b[2] << 24)
+    return sum(b[j] << (isa.BLOCK_BITS * j) for j in range(isa.BLOCKS))
 
 
 def register_history(line_cmds, width: int, carry_bug: bool = False, cycle0: int = 0

@@ -177,7 +177,7 @@ def model_trace(slots, chips: int, carry_bug: bool, pes: list[int], lo: int, hi:
         st, sk1, sk2b = hist[s]
         if p == 0:
             ident, d = t.seq[s]
-            ident, data = ident, (d & M) | (sk1 << 12) | (sk2b << 24)
+            ident, data = ident, isa.blocks_word((d & M, sk1, sk2b))
         else:
             ident, data = int(st["id1"][pos[p - 1]]), int(st["out"][pos[p - 1]])
         return _fmt_row(c, p, t.line_of_slot(slot), ident, data, st, pos[p])
@@ -228,8 +228,8 @@ def rtl_trace(slots, chips: int, carry_bug: bool, pes: list[int], lo: int, hi: i
 # ---- formatting and comparing ------------------------------------------------------------
 
 def _word(h: str) -> str:
-    v = int(h, 16)
-    return f"{v >> 24:03x}.{(v >> 12) & 0xFFF:03x}{v & 0xFFF:03x}"
+    b0, b1, b2 = isa.word_blocks(int(h, 16))
+    return f"{b2:03x}.{b1:03x}{b0:03x}"
 
 
 def text_row(r: str) -> str:
@@ -257,8 +257,8 @@ def first_difference(a: list[str], b: list[str]) -> dict | None:
                    "block": None}
             if name in WORD_COLUMNS:
                 va, vb = int(x, 16), int(y, 16)
-                out["block"] = next(j for j in range(3) if (va >> 12 * j & 0xFFF)
-                                    != (vb >> 12 * j & 0xFFF))
+                out["block"] = next(j for j, (p, q) in enumerate(
+                    zip(isa.word_blocks(va), isa.word_blocks(vb))) if p != q)
             return out
     if len(a) != len(b):
         return {"cycle": None, "pe": None, "column": "rows", "a": str(len(a)),
@@ -275,8 +275,9 @@ def describe(d: dict | None, what_a: str = "RTL", what_b: str = "model") -> str:
     if d["block"] is not None:
         j = d["block"]
         va, vb = int(d["a"], 16), int(d["b"], 16)
-        s += (f"{d['column']} block {j} (bits {12 * j + 11}:{12 * j}): {what_a} "
-              f"{va >> 12 * j & 0xFFF:03x}, {what_b} {vb >> 12 * j & 0xFFF:03x} "
+        (msb, lsb), a_j, b_j = isa.block_bits(j), isa.word_blocks(va)[j], isa.word_blocks(vb)[j]
+        s += (f"{d['column']} block {j} (bits {msb}:{lsb}): {what_a} "
+              f"{a_j:03x}, {what_b} {b_j:03x} "
               f"(words {_word(d['a'])} / {_word(d['b'])})")
     else:
         s += f"{d['column']}: {what_a} {d['a']}, {what_b} {d['b']}"

@@ -76,6 +76,11 @@ hsr_status yp_anim_load(const char *path, yp_anim **out, char *err, size_t errle
             if (nt != 2 || a->sc) AFAIL("expected one 'scene FILE'");
             char p[2048];
             if (tok[1][0] == '/') snprintf(p, sizeof p, "%s", tok[1]); else snprintf(p, sizeof p, "%s/%s", dir, tok[1]);
+            /* a scene that cannot be opened is this line's error (the scene's own errors
+             * name the scene file and its line) */
+            FILE *sf = fopen(p, "rb");
+            if (!sf) AFAIL("cannot read scene file '%s' (%s)", p, hsr_status_str(HSR_EIO));
+            fclose(sf);
             st = hsr_scene_load(p, &a->sc, err, errlen);
             if (st != HSR_OK) goto fail;
         } else if (!strcmp(tok[0], "frames")) {

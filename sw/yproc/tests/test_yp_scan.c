@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "de_isa.h"
 #include "t.h"
 #include "yp_internal.h"
 
@@ -375,11 +376,17 @@ static void test_yp_de48_stream_layout(void)
     unsigned char b[4096];
     size_t n = f ? fread(b, 1, sizeof b, f) : 0;
     if (f) fclose(f);
-    CHECK(n >= 8 && !memcmp(b, "DE48\0\1\0\0", 8) && (n - 8) % 6 == 0);
+    /* a record is the identifier above the 36-bit word, MSB first (sw/include/de_isa.h) */
+    const size_t rec = DE_RECORD_BITS / 8;
+    CHECK(n >= 8 && !memcmp(b, "DE48\0\1\0\0", 8) && (n - 8) % rec == 0);
     int refresh = 0;
-    for (size_t i = 8; i + 6 <= n; i += 6) refresh += ((b[i] << 4) | (b[i + 1] >> 4)) == 0x100;
+    for (size_t i = 8; i + rec <= n; i += rec) {
+        uint64_t w = 0;
+        for (size_t k = 0; k < rec; k++) w = w << 8 | b[i + k];
+        refresh += ((w >> DE_WORD_BITS) & DE_ID_MASK) == DE_ID_REFRESH;
+    }
     CHECK(refresh == 3);
-    CHECK((n - 8) / 6 == (size_t)(t.fr->line[0].slots + t.fr->line[1].slots + t.fr->line[2].slots + 3));
+    CHECK((n - 8) / rec == (size_t)(t.fr->line[0].slots + t.fr->line[1].slots + t.fr->line[2].slots + 3));
     teardown(&t);
 }
 
