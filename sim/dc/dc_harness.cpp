@@ -51,6 +51,7 @@ namespace {
 
 constexpr int kCh = 3;
 constexpr uint16_t kRefresh = DE_ID_REFRESH;
+constexpr unsigned kIdMagicLsb = 24;  // ID registers: the magic in ID[31:24] (docs/display-controller.md §6)
 
 struct Geom {
   int ha, hfp, hs, hbp, va, vfp, vs, vbp;
@@ -224,7 +225,7 @@ int main(int argc, char** argv) {
   tick();  // the controller's registers read one clock after the address (blank lines)
   tick();
   const uint32_t ctl_id = top->reg_rdata_o;
-  if ((ctl_id >> 24) != DE_CTRL_ID_MAGIC) {
+  if ((ctl_id >> kIdMagicLsb) != DE_CTRL_ID_MAGIC) {
     std::fprintf(stderr, "%s: controller ID register reads 0x%08x (want 0x%02X......)\n", argv[0], ctl_id,
                  DE_CTRL_ID_MAGIC);
     return 2;
@@ -418,7 +419,7 @@ int main(int argc, char** argv) {
   for (int c = 0; c < kCh; ++c) {
     const uint32_t base = static_cast<uint32_t>(c) << DE_REG_CHAN_LSB;
     const uint32_t id = rd(base + DE_LM_REG_ID);
-    if ((id >> 24) != DE_LM_ID_MAGIC) errors.push_back(std::string("load monitor ") + names[c] +
+    if ((id >> kIdMagicLsb) != DE_LM_ID_MAGIC) errors.push_back(std::string("load monitor ") + names[c] +
                                              ": bad ID register");
     const int bins = (id >> 16) & 0xFF, shift = (id >> 12) & 0xF;
     const uint32_t fc = rd(base + DE_LM_REG_FRAMES), iss = rd(base + DE_LM_REG_ISSUED),

@@ -366,17 +366,20 @@ bool write_gtkw(const std::string& fst, const std::vector<int>& pes, uint64_t t0
   char cwd[4096];
   std::string abs = fst;
   if (fst[0] != '/' && getcwd(cwd, sizeof cwd)) abs = std::string(cwd) + "/" + fst;
+  // Signal widths from de_isa.h: identifier, data word, pixel (= one block).
+  const int idm = DE_ID_BITS - 1, wm = DE_WORD_BITS - 1, bm = DE_BLOCK_BITS - 1;
   std::fprintf(f, "[dumpfile] \"%s\"\n[timestart] %llu\n[size] 1800 1000\n"
-               "[sst_expanded] 0\n@28\nTOP.clk_i\n@22\nTOP.id_i[11:0]\nTOP.data_i[35:0]\n"
-               "@28\nTOP.pix_valid_o\n@22\nTOP.pix_o[11:0]\n",
-               abs.c_str(), static_cast<unsigned long long>(t0));
+               "[sst_expanded] 0\n@28\nTOP.clk_i\n@22\nTOP.id_i[%d:0]\nTOP.data_i[%d:0]\n"
+               "@28\nTOP.pix_valid_o\n@22\nTOP.pix_o[%d:0]\n",
+               abs.c_str(), static_cast<unsigned long long>(t0), idm, wm, bm);
   for (int p : pes) {
     const std::string s = "TOP." + pe_scope(p) + ".";
-    std::fprintf(f, "-PE %d (chip %d, PE %d): identifier and skewed data in\n@22\n%sid_i[11:0]\n"
-                 "%sdata_i[35:0]\n", p, p / kPePerChip, p % kPePerChip, s.c_str(), s.c_str());
+    std::fprintf(f, "-PE %d (chip %d, PE %d): identifier and skewed data in\n@22\n%sid_i[%d:0]\n"
+                 "%sdata_i[%d:0]\n", p, p / kPePerChip, p % kPePerChip, s.c_str(), idm, s.c_str(), wm);
     std::fprintf(f, "-PE %d registers A-D as 12-bit blocks ([2] = integer part)\n", p);
     for (const char* r : {"a_q", "b_q", "c_q", "d_q"})
-      for (int j = 2; j >= 0; --j) std::fprintf(f, "%s%s.%s[%d][11:0]\n", s.c_str(), r, r, j);
+      for (int j = DE_BLOCKS - 1; j >= 0; --j)
+        std::fprintf(f, "%s%s.%s[%d][%d:0]\n", s.c_str(), r, r, j, bm);
     std::fprintf(f, "-PE %d block carries: c1 (0->1), c2 (1->2); ACC accc2, accc3\n@28\n", p);
     for (const char* r : {"c1_q", "c2_q", "accc2_q", "accc3_q", "accen2_q", "accen3_q"})
       std::fprintf(f, "%s%s\n", s.c_str(), r);

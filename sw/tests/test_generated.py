@@ -78,3 +78,45 @@ def test_video_mode_param_is_de_pkg_layout():
         isa.video_mode_param((4096, 1, 1, 1), (1, 1, 1, 1))
     with pytest.raises(ValueError):
         isa.video_mode_param((1, 1, 1), (1, 1, 1, 1))
+
+
+# A spoiled spec file through `python -m diffengine.isa.gen`: (name, file, spoil, where).
+# `where` is the FILE:LINE:COL the message must start with (tomllib's position).
+BAD_SPECS = [
+    ("bad_value", "spec/isa.toml", ("id_bits = 12", "id_bits = twelve"), "spec/isa.toml:7:11: "),
+    ("unclosed_table", "spec/regs.toml", ("[address]", "[address"), "spec/regs.toml:6:9: "),
+    ("unclosed_array", "spec/video.toml", ("vpol = false\n\n[[mode]]", "vpol = false\n\n[[mo"),
+     "spec/video.toml:16:5: "),
+    ("cut_short", "spec/regs.toml", ("", ""), "spec/regs.toml:14:12: "),
+]
+CUT = "hist_base = 0x040"   # spec/regs.toml cut short after "hist_base =": at the end of it
+
+
+@pytest.mark.parametrize("name,rel,spoil,where", BAD_SPECS, ids=[b[0] for b in BAD_SPECS])
+def test_bad_spec_names_file_and_line(tmp_path: Path, name, rel, spoil, where):
+    import subprocess
+    import sys
+    for r in gen.SPEC:
+        (tmp_path / r).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / r).write_text((gen.ROOT / r).read_text())
+    text = (tmp_path / rel).read_text()
+    assert spoil[0] in text
+    text = text.replace(spoil[0], spoil[1], 1)
+    if name == "cut_short":
+        text = text[:text.index(CUT) + len("hist_base =")]
+    (tmp_path / rel).write_text(text)
+    res = subprocess.run([sys.executable, "-m", "diffengine.isa.gen", "--spec-root", str(tmp_path),
+                          "--out", str(tmp_path / "out")], capture_output=True, text=True)
+    assert res.returncode == 1, res.stderr
+    assert "Traceback" not in res.stderr, res.stderr
+    assert res.stderr.startswith(f"{tmp_path}/{where}"), res.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_missing_spec_is_named(tmp_path: Path):
+    for r in gen.SPEC[:2]:
+        (tmp_path / r).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / r).write_text((gen.ROOT / r).read_text())
+    with pytest.raises(SystemExit) as e:
+        gen.load(tmp_path)
+    assert str(e.value) == f"{tmp_path}/spec/regs.toml: cannot read (No such file or directory)"

@@ -198,7 +198,7 @@ def out8(p: int, w: int, sat: bool) -> int:
     sh = p >> w
     if not sat:
         return sh & 0xFF
-    if p & 0x800:
+    if p & (1 << (isa.BLOCK_BITS - 1)):   # a negative pixel (its sign bit)
         return 0
     return 0xFF if sh >> 8 else sh & 0xFF
 
@@ -542,13 +542,18 @@ async def test_load_and_play(dut):
     assert st[15] == 0, f"late lines for want of SDRAM data: {st[15]}"
     assert nfr >= n_video, f"player frames {nfr} < displayed {n_video}"
     regs = {}
-    for name, addr in [("id", 0x3000)] + [(f"late{c}", c << 12 | 0x00A) for c in range(NCH)] \
-            + [(f"drop{c}", c << 12 | 0x009) for c in range(NCH)] + [("frames0", 0x001)]:
+    def reg(ch: int, r: int) -> int:      # host address (spec/regs.toml)
+        return ch << isa.REG_CHAN_LSB | r
+    for name, addr in [("id", reg(isa.REG_INFO_CHAN, isa.CTRL_REG_ID))] \
+            + [(f"late{c}", reg(c, isa.LM_REG_TOTAL_LATE)) for c in range(NCH)] \
+            + [(f"drop{c}", reg(c, isa.LM_REG_TOTAL_DROP)) for c in range(NCH)] \
+            + [("frames0", reg(0, isa.LM_REG_FRAMES))]:
         r = await host.command(with_chk(b"R" + addr.to_bytes(2, "big")), n_reply=5)
         assert r[0] == ord("R"), r
         regs[name] = int.from_bytes(r[1:], "big")
     lat = int(dut.SpanLatency.value) if int(dut.SpanArray.value) else g["NumChips"] + 3
-    assert regs["id"] == (0xDC << 24 | 3 << 20 | 1 << 16 | lat), hex(regs["id"])
+    magic_lsb = 24                       # the magic in ID[31:24] (docs/display-controller.md §6)
+    assert regs["id"] == (isa.CTRL_ID_MAGIC << magic_lsb | NCH << 20 | 1 << 16 | lat), hex(regs["id"])
     for c in range(NCH):
         assert regs[f"late{c}"] == 0 and regs[f"drop{c}"] == 0, regs
     assert regs["frames0"] >= n_video - 1, regs

@@ -198,13 +198,14 @@ def test_dropped_link_and_resume(tmp_path, capsys):
 # ---------------------------------------------------------------------- .de48 + animation
 def _line(rng, w):
     from diffengine import isa
+    from diffengine.formats import binfmt
     cmds = []
     for _ in range(rng.randrange(1, 4)):
         x = rng.randrange(0, 600)
         v = [rng.randrange(-1000, 1000) << (4 + w) for _ in range(2)]
         cmds.append(isa.Command("EVAL", x, rng.randrange(1, 40), tuple(v)))
     cmds.append(isa.Command("REFRESH"))
-    return b"".join((i << 36 | d).to_bytes(6, "big") for i, d in isa.serialise(cmds))
+    return binfmt.encode_de48(isa.serialise(cmds))[binfmt.HEADER_LEN:]
 
 
 @pytest.mark.parametrize("layout", ["yproc", "make_anim"])
@@ -269,10 +270,10 @@ def test_bad_inputs_name_file(tmp_path, capsys, monkeypatch):
     assert f"{tmp_path / 'no_scene'}: no such file or directory" in capsys.readouterr().err
     # A .de48 value below the window's grid: an error naming file and slot, unless --round.
     from diffengine import isa
+    from diffengine.formats import binfmt
     sl = isa.serialise([isa.Command("EVAL", 1, 2, (3, 1 << 20)), isa.Command("REFRESH")])
     for c in "rgb":
-        (tmp_path / f"{c}.de48").write_bytes(
-            b"DE48\0\1\0\0" + b"".join((i << 36 | d).to_bytes(6, "big") for i, d in sl))
+        (tmp_path / f"{c}.de48").write_bytes(binfmt.encode_de48(sl))
     de48 = [str(tmp_path / f"{c}.de48") for c in "rgb"]
     assert dl.main(["/nonexistent", *de48, "--window", "1"]) == 1
     err = capsys.readouterr().err

@@ -159,7 +159,7 @@ async def directed_boundaries(dut):
     """Spans at PE 0, the last PE, across every chip boundary, dX 0 and 1."""
     arr = await start(dut)
     n = arr.n
-    one = 1 << 24
+    one = 1 << isa.FRAC_BITS
     cmds = []
     for b in range(NUM_PE, n, NUM_PE):  # every chip boundary
         cmds += [isa.Command("EVAL", b - 2, 4, (10 * one, 3 * one, one // 2)),
@@ -266,8 +266,8 @@ async def table_7_5_through_the_mapper(dut):
     pos = dict(zip([n for n, _ in st.DBG_FIELDS], _field_pos()))
     for q in range(9):
         dbg = arr.pe_dbg(q)
-        a = (dbg >> pos["A"][0]) & ((1 << 36) - 1)
-        b = (dbg >> pos["B"][0]) & ((1 << 36) - 1)
+        a = (dbg >> pos["A"][0]) & isa.WORD_MASK
+        b = (dbg >> pos["B"][0]) & isa.WORD_MASK
         assert isa.format_fixed(b)[2:] == want_di[q], f"PE {q} dI {isa.format_fixed(b)}"
         assert isa.format_fixed(a)[2:] == want_i[q], f"PE {q} I {isa.format_fixed(a)}"
 

@@ -18,10 +18,13 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
+from diffengine import isa
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 
 HT, VA, VT = 24, 6, 11  # the test mode of de_video_timing
+MAGIC_LSB = 24          # the ID register: the magic in ID[31:24] (docs/display-controller.md §6)
 
 
 def get_seed() -> int:
@@ -47,7 +50,9 @@ class Model:
         self.tot_drop += n_drop
         if refresh and active:
             n_late = bin(late).count("1")
-            rec = (int(n_late > 0) << 31) | (n_late << 24) | (self.ln_free << 12) | self.ln_issued
+            # the line record (de_load_monitor.sv), not a data word
+            rec = ((int(n_late > 0) << 31) | (n_late << 24)  # isa-literal-ok
+                   | (self.ln_free << 12) | self.ln_issued)
             self.live["issued"] += self.ln_issued
             self.live["free"] += self.ln_free
             self.live["late"] += int(n_late > 0)
@@ -100,7 +105,8 @@ async def test_counts_under_overload(dut):
           "ev_issue_i", "ev_free_i", "drop_i"]
     from common.run import hold_reset
     await hold_reset(dut, 3, falling=False, reg_addr_i=0, **dict.fromkeys(ev, 0))
-    assert await read_reg(dut, 0) == (0xDE << 24) | (bins << 16) | (shift << 12) | (nb << 8) | 1
+    assert await read_reg(dut, isa.LM_REG_ID) == \
+        (isa.LM_ID_MAGIC << MAGIC_LSB) | (bins << 16) | (shift << 12) | (nb << 8) | 1
     model = Model(nb, bins, shift)
     full = (1 << nb) - 1
     # (issue probability, late probability per buffer, drop probability per buffer)

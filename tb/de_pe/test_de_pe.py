@@ -344,10 +344,10 @@ async def random_identifiers(dut):
     for _ in range(int(os.environ.get("DE_RANDOM_IDS", "600"))):
         ident = ids[int(rng.integers(0, len(ids)))]
         if rng.random() < 0.5:
-            data = int(rng.integers(0, 4)) | (int(rng.integers(0, 4)) << 12) \
-                | (int(rng.integers(0, 1 << 12)) << 24)
+            data = isa.blocks_word((int(rng.integers(0, 4)), int(rng.integers(0, 4)),
+                                    int(rng.integers(0, 1 << isa.BLOCK_BITS))))
         else:
-            data = int(rng.integers(0, 1 << 36))
+            data = int(rng.integers(0, 1 << isa.WORD_BITS))
         slots.append((ident, data))
     env.driver.send(slots)
     while env.driver.queue:
@@ -376,7 +376,7 @@ TABLE_7_5 = {  # column: (dI, I) as 0xIII.FFFFFF per PE, from the source
 
 def _fixed(s: str) -> int:
     i, fr = s.split(".")
-    return (int(i, 16) << 24) | int(fr, 16)
+    return (int(i, 16) << isa.FRAC_BITS) | int(fr, 16)
 
 
 @cocotb.test() if cocotb else (lambda f: f)
@@ -394,12 +394,12 @@ async def table_7_5(dut):
     assert got_a == i, f"{col} I: {got_a}"
     # and read the RTL directly, not only through the model
     dbg = dut.dbg_o.value.to_unsigned()
-    pos_a = st.DBG_WIDTH - 36
+    pos_a = st.DBG_WIDTH - isa.DBG_FIELDS[0][1]   # A: the first field, MSB first
     for p in range(9):
-        word = (dbg >> (p * st.DBG_WIDTH + pos_a)) & ((1 << 36) - 1)
+        word = (dbg >> (p * st.DBG_WIDTH + pos_a)) & isa.WORD_MASK
         assert word == _fixed(i[p]), f"PE {p} A {isa.format_fixed(word)}"
     await env.run([C("REFRESH")])
-    assert env.rows()[-1].tolist() == [_fixed(v) >> 24 for v in i]
+    assert env.rows()[-1].tolist() == [isa.pixel_of(_fixed(v)) for v in i]
 
 
 # ---- pytest runner --------------------------------------------------------------------------

@@ -47,7 +47,14 @@ from diffengine.regress import randgen
 
 NCH = 3
 REFRESH_ID = isa.REFRESH
-MASK48 = (1 << 48) - 1
+MASK48 = (1 << isa.RECORD_BITS) - 1
+WB = isa.WORD_BITS          # a record is {identifier, data}: the identifier above bit WB
+MAGIC_LSB = 24              # ID registers: the magic in ID[31:24] (docs/display-controller.md §6)
+
+
+def reg_addr(ch: int, reg: int) -> int:
+    """Host address of register `reg` of channel `ch` (spec/regs.toml)."""
+    return (ch << isa.REG_CHAN_LSB) | reg
 
 
 def geom(dut):
@@ -61,11 +68,11 @@ def geom(dut):
 
 
 def words_of(cmds) -> list[int]:
-    return [(i << 36) | d for i, d in isa.serialise(cmds)]
+    return [(i << WB) | d for i, d in isa.serialise(cmds)]
 
 
 def is_start(w: int) -> bool:
-    return ((w >> 45) & 3) == 0
+    return ((w >> WB) & (isa.ID_ADDR | isa.ID_DATA)) == 0
 
 
 def make_streams(seed: int, g: dict, n_lines: int, per_line, max_words: int | None):
@@ -110,7 +117,7 @@ class Bench:
                 q, lo, mk = [], [], []
                 for n, ln in enumerate(streams[c][i]):
                     ws = words_of(ln)
-                    q += ws + [REFRESH_ID << 36]
+                    q += ws + [REFRESH_ID << WB]
                     lo += [n] * (len(ws) + 1)
                     mk.append(len(q) - 1)
                 self.queues.append(q)
@@ -145,9 +152,9 @@ class Bench:
                         self.pos[p] += 1
                 if self.cur[p] is not None:
                     valid |= 1 << p
-                    data |= self.cur[p] << (48 * p)
+                    data |= self.cur[p] << (isa.RECORD_BITS * p)
                     if (ready >> p) & 1:   # ready depends on registers only
-                        if (self.cur[p] >> 36) != REFRESH_ID:
+                        if (self.cur[p] >> WB) != REFRESH_ID:
                             self.written[p][self.cur_line[p]] += 1
                         self.cur[p] = None
             dut.wr_valid_i.value = valid
@@ -165,7 +172,7 @@ class Bench:
         while True:
             await RisingEdge(dut.clk_i)
             await ReadOnly()
-            if (int(core.instr_o.value) & MASK48) >> 36 == REFRESH_ID:
+            if (int(core.instr_o.value) & MASK48) >> WB == REFRESH_ID:
                 v = (self.g["TestVActive"] + self.n_refresh) % self.g["VTotal"]
                 self.closed += v < self.g["TestVActive"]
                 self.n_refresh += 1
@@ -200,7 +207,8 @@ def analyse_bus(bench):
     refresh_at = []
     for c in range(NCH):
         refresh_at.append([t for t, s in enumerate(bench.samples)
-                           if ((s["instr"] >> (48 * c + 36)) & 0xFFF) == REFRESH_ID])
+                           if ((s["instr"] >> (isa.RECORD_BITS * c + WB)) & isa.ID_MASK)
+                           == REFRESH_ID])
         assert refresh_at[c] == refresh_at[0], "colour channels out of lockstep"
         assert all(b - a == g["HTotal"] for a, b in zip(refresh_at[c], refresh_at[c][1:]))
         wins = []
@@ -208,9 +216,9 @@ def analyse_bus(bench):
         cur = dict(words=[], per_buf=[[] for _ in range(nb)], order=[], nops=0)
         prev_owner = None        # buffer of the previous slot's word (None: Nop/Refresh)
         for t, s in enumerate(bench.samples):
-            w = (s["instr"] >> (48 * c)) & MASK48
+            w = (s["instr"] >> (isa.RECORD_BITS * c)) & MASK48
             gr = s["grant"][c]
-            if (w >> 36) == REFRESH_ID:
+            if (w >> WB) == REFRESH_ID:
                 assert gr == 0, f"ch{c} t={t}: Refresh with a grant"
                 # Refresh k is the one of line VActive + k (reset starts in the blank).
                 v = (g["TestVActive"] + k) % g["VTotal"]
@@ -379,14 +387,14 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
     regs = {}
     for c in range(NCH):      # the line table first: line 0 is rewritten after the blank
         for ln in range(va):
-            regs[(c, 0x400 + ln)] = await read_reg(dut, (c << 12) | 0x400 + ln)
+            regs[(c, isa.LM_LINE_BASE + ln)] = await read_reg(
+                dut, reg_addr(c, isa.LM_LINE_BASE + ln))
     for c in range(NCH):
-        base = c << 12
-        for a in [0x0, 0x1, 0x2, 0x3, 0x4, 0x5, 0x6, 0x7, 0x8]:
-            regs[(c, a)] = await read_reg(dut, base | a)
+        for a in range(isa.LM_REG_ID, isa.LM_REG_LAST_REC + 1):
+            regs[(c, a)] = await read_reg(dut, reg_addr(c, a))
         for b in range(int(dut.NumBins.value)):
-            regs[(c, 0x40 + b)] = await read_reg(dut, base | 0x40 + b)
-    info = await read_reg(dut, 3 << 12)
+            regs[(c, isa.LM_HIST_BASE + b)] = await read_reg(dut, reg_addr(c, isa.LM_HIST_BASE + b))
+    info = await read_reg(dut, reg_addr(isa.REG_INFO_CHAN, isa.CTRL_REG_ID))
     # Let every late line drain before the totals are read.
     for _ in range(40):
         await ClockCycles(dut.clk_i, ht)
@@ -397,9 +405,9 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
     assert bench.all_written(), "y-processors could not write everything"
     tot, t_read = {}, {}
     for c in range(NCH):
-        tot[(c, 9)] = await read_reg(dut, (c << 12) | 0x9)
+        tot[(c, isa.LM_REG_TOTAL_DROP)] = await read_reg(dut, reg_addr(c, isa.LM_REG_TOTAL_DROP))
         t_read[c] = len(bench.samples)
-        tot[(c, 10)] = await read_reg(dut, (c << 12) | 0xA)
+        tot[(c, isa.LM_REG_TOTAL_LATE)] = await read_reg(dut, reg_addr(c, isa.LM_REG_TOTAL_LATE))
     bench.stop = True
     all_wins = analyse_bus(bench)
     # The windows whose lines belong to the streams.
@@ -408,7 +416,8 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
     n = check_video(bench, gold, w8, sat8)
 
     # ---- Load Monitor read-out vs the buses ---------------------------------------
-    assert info == (0xDC << 24) | (3 << 20) | (g["NumBuf"] << 16) | g["ArrayLatency"]
+    assert info == ((isa.CTRL_ID_MAGIC << MAGIC_LSB) | (NCH << 20) | (g["NumBuf"] << 16)
+                    | g["ArrayLatency"])
     nbins, shift = int(dut.NumBins.value), int(dut.BinShift.value)
     util = []
     total_late_lines = 0
@@ -416,37 +425,41 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
         ws = wins[c]
         assert len(ws) == n_lines
         frame = ws[-va:]
-        assert regs[(c, 0)] == (0xDE << 24) | (nbins << 16) | (shift << 12) | \
-            (g["NumBuf"] << 8) | 1
-        assert regs[(c, 1)] == frames, f"ch{c}: FRAME_COUNT"
+        assert regs[(c, isa.LM_REG_ID)] == (isa.LM_ID_MAGIC << MAGIC_LSB) | (nbins << 16) | \
+            (shift << 12) | (g["NumBuf"] << 8) | 1
+        assert regs[(c, isa.LM_REG_FRAMES)] == frames, f"ch{c}: FRAME_COUNT"
         issued = [len(w["words"]) for w in frame]
         free = [w["nops"] for w in frame]
         late = [sum(w["late"]) for w in frame]
         for w in ws:
             assert len(w["words"]) + w["nops"] == ht - 1, "window length"
-        assert regs[(c, 2)] == sum(issued), f"ch{c}: SNAP_ISSUED"
-        assert regs[(c, 3)] == sum(free), f"ch{c}: SNAP_FREE"
-        assert regs[(c, 4)] == sum(1 for x in late if x), f"ch{c}: SNAP_LATE_LINES"
-        assert regs[(c, 6)] == max(issued), f"ch{c}: SNAP_MAX_ISSUED"
-        assert regs[(c, 7)] == va - 1, f"ch{c}: LAST_LINE"
+        assert regs[(c, isa.LM_REG_ISSUED)] == sum(issued), f"ch{c}: SNAP_ISSUED"
+        assert regs[(c, isa.LM_REG_FREE)] == sum(free), f"ch{c}: SNAP_FREE"
+        assert regs[(c, isa.LM_REG_LATE)] == sum(1 for x in late if x), f"ch{c}: SNAP_LATE_LINES"
+        assert regs[(c, isa.LM_REG_MAX_ISSUED)] == max(issued), f"ch{c}: SNAP_MAX_ISSUED"
+        assert regs[(c, isa.LM_REG_LAST_LINE)] == va - 1, f"ch{c}: LAST_LINE"
         hist = [0] * nbins
         for x in issued:
             hist[min(x >> shift, nbins - 1)] += 1
-        assert [regs[(c, 0x40 + b)] for b in range(nbins)] == hist, f"ch{c}: histogram"
+        assert [regs[(c, isa.LM_HIST_BASE + b)] for b in range(nbins)] == hist, f"ch{c}: histogram"
         for ln in range(va):
-            rec = (int(late[ln] > 0) << 31) | (late[ln] << 24) | (free[ln] << 12) | issued[ln]
-            assert regs[(c, 0x400 + ln)] == rec, f"ch{c}: LINE[{ln}] record"
-        assert regs[(c, 8)] == regs[(c, 0x400 + va - 1)], f"ch{c}: LAST_REC"
+            # the Load Monitor's line record (de_load_monitor.sv), not a data word
+            rec = ((int(late[ln] > 0) << 31) | (late[ln] << 24)  # isa-literal-ok
+                   | (free[ln] << 12) | issued[ln])
+            assert regs[(c, isa.LM_LINE_BASE + ln)] == rec, f"ch{c}: LINE[{ln}] record"
+        assert regs[(c, isa.LM_REG_LAST_REC)] == regs[(c, isa.LM_LINE_BASE + va - 1)], \
+            f"ch{c}: LAST_REC"
         # Discards: every word a y-processor wrote for a line but that never reached
         # the bus (markers excluded).
         dropped = 0
         for n_, w in enumerate(ws):
             for i in range(g["NumBuf"]):
                 dropped += bench.written[c * g["NumBuf"] + i][n_] - len(w["per_buf"][i])
-        assert tot[(c, 9)] == dropped, f"ch{c}: TOTAL_DROPPED {tot[(c, 9)]} != {dropped}"
+        dr = tot[(c, isa.LM_REG_TOTAL_DROP)]
+        assert dr == dropped, f"ch{c}: TOTAL_DROPPED {dr} != {dropped}"
         # Late lines up to the read, including any after the streams ended.
         lates = sum(1 for w in all_wins[c] if w["t"] < t_read[c] and any(w["late"]))
-        assert tot[(c, 10)] == lates, f"ch{c}: TOTAL_LATE_LINES"
+        assert tot[(c, isa.LM_REG_TOTAL_LATE)] == lates, f"ch{c}: TOTAL_LATE_LINES"
         total_late_lines += sum(1 for w in ws if any(w["late"]))
         per_line = [len(w["words"]) / (ht - 1) for w in ws]
         util.append((sum(per_line) / len(per_line), min(per_line), max(per_line)))
@@ -454,9 +467,9 @@ async def run_frames(dut, stall_p, per_line, max_words, frames, w8, sat8, overlo
                   f"R/G/B mean (min..max per line) = "
                   f"{', '.join(f'{u[0]:.3f} ({u[1]:.3f}..{u[2]:.3f})' for u in util)}; late lines "
                   f"{total_late_lines}; dropped words "
-                  f"{[tot[(c, 9)] for c in range(NCH)]}")
+                  f"{[tot[(c, isa.LM_REG_TOTAL_DROP)] for c in range(NCH)]}")
     if overload:
-        assert total_late_lines > 0 and sum(tot[(c, 9)] for c in range(NCH)) > 0
+        assert total_late_lines > 0 and sum(tot[(c, isa.LM_REG_TOTAL_DROP)] for c in range(NCH)) > 0
     else:
         assert total_late_lines == 0, "underload test had a late line"
     return util

@@ -146,7 +146,7 @@ def test_click_shows_commands_and_registers(page):
     last = hist[-1]
     assert [int(last[f"data-{r}"]) for r in "abcd"] == [int(st.A[x]), int(st.B[x]),
                                                        int(st.C[x]), int(st.D[x])]
-    assert int(last["data-d"]) >> 24 & 0xFFF == int(frame[y, x])
+    assert isa.pixel_of(int(last["data-d"])) == int(frame[y, x])
     # every row equals the structural model's trace row at the cycle the page names,
     # except where the line's Refresh reaches the PE before the command's last block
     slots = isa.serialise(cmds)

@@ -26,6 +26,7 @@ def budget():
 
 def test_words_per_line_of_a_stream(tmp_path):
     from diffengine import isa
+    from diffengine.formats import binfmt
     rng = random.Random(5)
     want, cmds = [], []
     for _ in range(7):
@@ -37,8 +38,7 @@ def test_words_per_line_of_a_stream(tmp_path):
         want.append(n)
     slots = isa.serialise(cmds)
     path = tmp_path / "r.de48"
-    path.write_bytes(b"DE48\0\1\0\0" + b"".join((i << 36 | d).to_bytes(6, "big")
-                                                 for i, d in slots))
+    path.write_bytes(binfmt.encode_de48(slots))
     got = budget().words_per_line(path)
     # One word per slot, the marker included: an EVAL is several slots, so count them.
     per_line, k = [], 0

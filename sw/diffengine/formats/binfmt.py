@@ -29,7 +29,10 @@ FLAG_COMPENSATE = 0x01
 FS_WINDOWS = range(0, 5)
 OPERAND_BITS = 27
 OPERAND_MASK = (1 << OPERAND_BITS) - 1
-FS_ADDR_MAX = 1023
+# The frame store's address-type operand: X, dX of FS_ADDR_BITS each, then a 7-bit Eval0
+# intensity (de_data_mapper's layout, docs/formats.md).
+FS_ADDR_BITS = 10
+FS_ADDR_MAX = (1 << FS_ADDR_BITS) - 1
 
 
 def _sext(value: int, bits: int) -> int:
@@ -189,8 +192,9 @@ def map_word(word: int, window: int, compensate: bool = False) -> tuple[int, int
     if typ == isa.TYPE_NONE:
         return ident, 0
     if typ == isa.TYPE_ADDR:
-        pixel = (_sext(operand >> 20, 7) << window) & isa.BLOCK_MASK
-        return ident, isa.blocks_word((operand & 0x3FF, (operand >> 10) & 0x3FF, pixel))
+        pixel = (_sext(operand >> 2 * FS_ADDR_BITS, 7) << window) & isa.BLOCK_MASK
+        return ident, isa.blocks_word((operand & FS_ADDR_MAX,
+                                       (operand >> FS_ADDR_BITS) & FS_ADDR_MAX, pixel))
     value = _sext(operand, OPERAND_BITS) << (4 + window)
     if compensate:
         value = isa.compensate(value)
@@ -207,12 +211,13 @@ def _fs_operand(ident: int, data: int, window: int) -> int:
         names = ("dX", "X") if ident == isa.ADDR_PERIODIC else ("X", "dX")
         for n, v in zip(names, (b0, b1)):
             if v > FS_ADDR_MAX:
-                raise ValueError(f"{n} = {v}: the frame store addresses columns 0..1023 only")
+                raise ValueError(f"{n} = {v}: the frame store addresses columns "
+                                 f"0..{FS_ADDR_MAX} only")
         op7 = (b2 >> window) & 0x7F
         if (_sext(op7, 7) << window) & isa.BLOCK_MASK != b2:
             raise ValueError(f"Eval0 intensity {b2} does not fit the 7-bit frame-store field at "
                              f"window {window} (multiples of {1 << window} up to {63 << window})")
-        return b0 | b1 << 10 | op7 << 20
+        return b0 | b1 << FS_ADDR_BITS | op7 << 2 * FS_ADDR_BITS
     v = isa.to_signed(data)
     low = 4 + window
     if v & ((1 << low) - 1):

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import re
 import sys
 import tomllib
 from pathlib import Path
@@ -26,13 +27,33 @@ PY_OUT = "sw/diffengine/isa/_tables.py"
 COMMAND = "python -m diffengine.isa.gen"
 
 
+def read_toml(path: Path) -> dict:
+    """One spec file; a syntax error or an unreadable file exits 1 naming FILE:LINE:COL."""
+    shown = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except OSError as e:
+        raise SystemExit(f"{shown}: cannot read ({e.strerror})") from None
+    except tomllib.TOMLDecodeError as e:
+        msg = str(e)
+        line, col = getattr(e, "lineno", None), getattr(e, "colno", None)
+        m = re.search(r"\s*\(at line (\d+), column (\d+)\)$", msg)
+        if m:
+            msg = msg[:m.start()]
+            line, col = line or int(m.group(1)), col or int(m.group(2))
+        elif msg.endswith("(at end of document)"):
+            msg = msg[:-len("(at end of document)")].rstrip()
+            text = path.read_bytes().decode("utf-8", "replace")
+            line, col = text.count("\n") + 1, len(text.rsplit("\n", 1)[-1]) + 1
+        where = f"{shown}:{line}:{col}" if line else f"{shown}"
+        raise SystemExit(f"{where}: {msg}") from None
+
+
 def load(root: Path = ROOT) -> dict:
-    with open(root / SPEC[0], "rb") as f:
-        spec = tomllib.load(f)
-    with open(root / SPEC[1], "rb") as f:
-        spec["video"] = tomllib.load(f)
-    with open(root / SPEC[2], "rb") as f:
-        spec["regs"] = tomllib.load(f)
+    spec = read_toml(root / SPEC[0])
+    spec["video"] = read_toml(root / SPEC[1])
+    spec["regs"] = read_toml(root / SPEC[2])
     check(spec)
     return spec
 
@@ -477,8 +498,10 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog=COMMAND, description=__doc__.split("\n\n")[0])
     ap.add_argument("--check", action="store_true", help="diff against the checked-in files; exit 1 on a difference")
     ap.add_argument("--out", type=Path, default=ROOT, help="root to write under (default: the repository)")
+    ap.add_argument("--spec-root", type=Path, default=ROOT,
+                    help="root whose spec/*.toml are read (default: the repository)")
     a = ap.parse_args(argv)
-    files = outputs(load())
+    files = outputs(load(a.spec_root.resolve()))
     bad = 0
     for rel, text in files.items():
         path = a.out / rel

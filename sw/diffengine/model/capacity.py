@@ -65,8 +65,9 @@ def _controller_mode(index: int, fps: int) -> VideoMode:
 
 
 MODES = {
+    # The source's 50 Hz modes (its own figures, not spec/video.toml's): isa-literal-ok.
     "640x485@50": VideoMode(640, 485, 820, 525, 50),        # the source's low-res mode
-    "1280x1024@50": VideoMode(1280, 1024, 1720, 1066, 50),  # the source's high-res mode
+    "1280x1024@50": VideoMode(1280, 1024, 1720, 1066, 50),  # high-res, isa-literal-ok
     # The controller's modes 0 and 2 (spec/video.toml).
     "640x480@60": _controller_mode(0, 60),                  # VGA, 25.2 MHz
     "1280x1024@60": _controller_mode(2, 60),                # VESA, 108 MHz

@@ -322,11 +322,12 @@ def random_value(rng: np.random.Generator) -> int:
     """A signed 12.24 intensity: mostly small, sometimes full-range or near a carry."""
     k = rng.integers(0, 6)
     if k == 0:
-        return int(rng.integers(-(1 << 35), 1 << 35))
+        return int(rng.integers(-(1 << (isa.WORD_BITS - 1)), 1 << (isa.WORD_BITS - 1)))
     if k == 1:  # fraction near the block-1 -> block-2 carry boundary
-        return int(rng.integers(-(1 << 24), 1 << 24)) | int(rng.integers(0, 2)) * 0xFFF000
+        return (int(rng.integers(-(1 << isa.FRAC_BITS), 1 << isa.FRAC_BITS))
+                | int(rng.integers(0, 2)) * (M << BLK))
     if k == 2:  # block-0 -> block-1 carry boundary
-        return int(rng.integers(-(1 << 13), 1 << 13)) + 0xFFF * int(rng.integers(0, 2))
+        return int(rng.integers(-(1 << (BLK + 1)), 1 << (BLK + 1))) + M * int(rng.integers(0, 2))
     if k == 3:
         return 0
     return int(rng.integers(-(1 << 30), 1 << 30))

@@ -20,7 +20,7 @@ import numpy as np
 from .. import REPO, isa
 from ..formats import binfmt, frame
 from ..model import fast, functional
-from .demo import build_yproc
+from .demo import H_TOTAL, build_yproc
 
 Line = list[bytes]   # the 6-byte words of one line, its Refresh last
 
@@ -605,7 +605,7 @@ def configure(ap) -> None:
     ap.add_argument("--rtl", action="store_true",
                     help="with --lod-loop: the per-line counts come from the Verilated display "
                          "controller's Load Monitor, frame by frame, instead of yproc's model "
-                         "(test-mode geometry, HTotal 800 unless 640x480; slow at full size)")
+                         f"(test-mode geometry, HTotal {H_TOTAL} unless 640x480; slow at full size)")
     ap.add_argument("--chips", type=int, help="with --rtl: chips per colour (default: the fewest "
                     "that cover the width)")
     ap.add_argument("--compare-model", action="store_true",
@@ -615,7 +615,7 @@ def configure(ap) -> None:
                     help="instead: one plot of several --lod-loop --rtl --compare-model outputs -> "
                          "--out/lod_rtl.png")
     ap.add_argument("--htotal", type=int, help="with --rtl: the controller's HTotal in test mode, "
-                    "porches 4 + 8 (slots per line + 2; default 800, or the 640x480 mode)")
+                    f"porches 4 + 8 (slots per line + 2; default {H_TOTAL}, or the 640x480 mode)")
     ap.add_argument("--capacity", type=int, help="with --lod-loop: yproc's slots per line "
                     "(default: the mode's, or with --rtl the controller's HTotal - 2)")
     ap.add_argument("--coherent", action="store_true",

@@ -33,7 +33,7 @@ YPROC = yproc.YPROC
 MIN_PSNR = 38.0
 # Mode 0 (640x480, spec/video.toml): its line of 800 is a 799-slot window, 798 usable
 # (docs/pipeline.md 1.1); test-mode screens keep its line length and its HFp / HSync.
-_, (_, H_FP, H_SYNC, _), _, _, _ = isa.VIDEO_MODES[0]
+_, (H_ACTIVE, H_FP, H_SYNC, _), (V_ACTIVE, *_), _, _ = isa.VIDEO_MODES[0]
 H_TOTAL = sum(isa.VIDEO_MODES[0][1])
 
 
@@ -101,7 +101,7 @@ def controller_setup(width: int, height: int, chips: int) -> tuple[int, tuple]:
     if chips * 9 < width:
         raise PipelineError(f"{chips} chips = {chips * 9} PEs per colour cannot show "
                             f"{width} columns (need at least {-(-width // 9)} chips)")
-    if (width, height) == (640, 480):
+    if (width, height) == (H_ACTIVE, V_ACTIVE):
         return 0, dc_harness.DEFAULT_TEST
     if width + H_FP + H_SYNC + 1 > H_TOTAL:
         raise PipelineError(f"screen width {width}: only 640x480 or widths up to "

@@ -25,7 +25,8 @@ from .. import isa, REPO
 from ..formats import binfmt
 
 DEFAULT_TEST = (16, 2, 3, 3, 6, 1, 2, 2)
-MODES = {0: (640, 480), 1: (640, 485), 2: (1280, 1024)}
+# Each fixed mode's (HActive, VActive), from spec/video.toml.
+MODES = {i: (h[0], v[0]) for i, (_, h, v, _, _) in isa.VIDEO_MODES.items()}
 
 
 @dataclass(frozen=True)

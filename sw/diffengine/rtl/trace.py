@@ -119,8 +119,8 @@ def parse_op(text: str) -> int:
     except ValueError:
         raise TraceError(f"--break-op {text!r}: not a mnemonic ({', '.join(names)}) "
                          "nor an identifier") from None
-    if not 0 <= v < 4096:
-        raise TraceError(f"--break-op {text!r}: identifiers are 0..0xfff")
+    if not 0 <= v <= isa.ID_MASK:
+        raise TraceError(f"--break-op {text!r}: identifiers are 0..{isa.ID_MASK:#x}")
     return v
 
 
