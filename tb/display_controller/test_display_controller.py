@@ -72,7 +72,7 @@ def words_of(cmds) -> list[int]:
 
 
 def is_start(w: int) -> bool:
-    return ((w >> WB) & (isa.ID_ADDR | isa.ID_DATA)) == 0
+    return ((w >> WB) & (isa.ID_DATA | isa.ID_ACC)) == 0   # de_pkg::id_starts_cmd
 
 
 def make_streams(seed: int, g: dict, n_lines: int, per_line, max_words: int | None):
