@@ -19,7 +19,9 @@ has no other meaning. test_the_scanner_catches_every_variant plants each variant
 from __future__ import annotations
 
 import ast
+import io
 import re
+import tokenize
 from pathlib import Path
 
 import pytest
@@ -197,20 +199,11 @@ def _blank_py_comments(text: str) -> list[str]:
                 and isinstance(node.value.value, str)):
             for k in range(node.lineno - 1, node.end_lineno):
                 lines[k] = ""
-    return [_strip_py_comment(line) for line in lines]
-
-
-def _strip_py_comment(line: str) -> str:
-    quote = None
-    for i, c in enumerate(line):
-        if quote:
-            if c == quote:
-                quote = None
-        elif c in "'\"":
-            quote = c
-        elif c == "#":
-            return line[:i]
-    return line
+    for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+        if tok.type == tokenize.COMMENT:
+            row, col = tok.start
+            lines[row - 1] = lines[row - 1][:col]
+    return lines
 
 
 def code_lines(path: Path) -> list[str]:
@@ -315,8 +308,10 @@ def test_the_scanner_catches_every_variant(tmp_path: Path, rel: str, line: str):
 
 def test_comments_and_docstrings_are_not_scanned(tmp_path: Path):
     (tmp_path / "a.c").write_text("/* 0x4B4\n   id_i[8] 800 */ int x; // 0x100\n")
-    (tmp_path / "b.py").write_text('"""0x4B4\n800"""\nx = "#"  # 0x100\n')
+    (tmp_path / "b.py").write_text('"""0x4B4\n800"""\nx = "#"  # 0x100\n'
+                                   'y = ("it\'s",  # 0x100\n     """a\nb\'s""")  # 0x100\n')
     places = [("a.c", ISA + (VIDEO_TOTAL,)), ("b.py", ISA + (VIDEO_TOTAL,))]
     assert stray(tmp_path, places) == []
     (tmp_path / "a.c").write_text("/* 0x4B4 */ int x = 0x100;\n")
-    assert [f.split(" ", 1)[0] for f in stray(tmp_path, places)] == ["a.c:1:"]
+    (tmp_path / "b.py").write_text('"""doc"""\nx = 1  # 0x100\ny = 0x100  # code\n')
+    assert [f.split(" ", 1)[0] for f in stray(tmp_path, places)] == ["a.c:1:", "b.py:3:"]
