@@ -456,15 +456,16 @@ def render(rec: dict) -> str:
     fifo_txt = (f"\n(the board's span FIFO holds {brd['fifo_slots']:,} slots, "
                 f"{brd['sources']['fifo']})" if brd else "")
     src = brd.get("sources", {})
-    board_txt = (f"the board's ratio, {fmt_ratio(ratio)} ({brd['core_mhz']:g} MHz core / "
-                 f"{brd['pixel_mhz']:g} MHz pixel clock, from the PLL's dividers, "
+    board_txt = (f"the board's ratio, {fmt_ratio(ratio)}\n({brd['core_mhz']:g} MHz core / "
+                 f"{brd['pixel_mhz']:g} MHz pixel clock: the PLL's CLKOS_DIV / CLKOS2_DIV, "
                  f"{src.get('ratio')})" if brd and Fraction(brd["ratio"]) == ratio
                  else f"ratio {fmt_ratio(ratio)}")
     body = f"""{SECTION}
 
-Reproduce: `make bench-span` (`diffengine bench span --write`, {minutes:.0f} min of RTL runs on
-{rec['date']}, load average {rec['load_before']} before, {rec['load_after']} after;
-cycle counts do not depend on the load).
+Reproduce: `make bench-span` (`diffengine bench span --write`,
+{rec['seconds'] / 60:.0f} min, of which {minutes:.0f} min of RTL runs, on {rec['date']} UTC,
+load average {rec['load_before']} before, {rec['load_after']} after: other jobs shared the 2
+cores; cycle counts do not depend on the load).
 Each 640x480 colour stream of `yproc scan` goes through the Verilated `de_span_array`
 (648 columns, 4 slots per pass, Forward, Prefetch, a 32-entry pass table) once unpaced
 and once paced at each ratio, and every frame must equal the functional model bit for
