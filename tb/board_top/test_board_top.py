@@ -617,7 +617,7 @@ async def test_fetch_budget(dut):
     are on time over 48 frames (the refresh, every 182.4 pixel clocks, walks through the
     187-clock frame in 40), every frame after the switch the golden image; one word more
     per line is late, and every late line is counted (status byte 15, the Load Monitors'
-    late lines and dropped words), none silently."""
+    late lines and dropped words), none silently; the frames it spoils are reported."""
     from common.run import seed_from_env
     rng = random.Random(seed_from_env())
     g = geom(dut)
@@ -663,8 +663,9 @@ async def test_fetch_budget(dut):
     assert over["starved"] > 0 and late >= over["starved"] and drop > 0, (
         f"{sizes[1]} words a line: not late (LINE_BUDGET too low?) or late lines not "
         f"counted: {over}")
+    # How many frames the late lines spoil depends on the words cut (Nops, or pixels the
+    # output window clips, change nothing): counted above, reported here.
     bad = sum(1 for f in shown1 if not frame_index(f, imgs))   # neither image
-    assert bad > 0, f"{sizes[1]} words a line: {over} counted, but every frame is right"
     nerr = int(dut.err_count_o.value)
     assert nerr == 0, f"the SDRAM model saw {nerr} timing violations"
     dut._log.info(f"fetch budget: {sizes[0]} words a line in all three colours on time, "
