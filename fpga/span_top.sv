@@ -18,8 +18,13 @@ module span_top #(
   input  logic sin_i,
   output logic fold_o
 );
-  localparam int unsigned InW  = 1 + 12 + 36;            // valid, identifier, data
-  localparam int unsigned OutW = 1 + 1 + 12 + 12 + 1;    // ready, pixel valid/value/col, busy
+  // In: valid, then one record {identifier, data} (de_pkg RecW), split as de_pkg's
+  // rec_id / rec_data split it; as slices, since calling them gave yosys an equivalent
+  // but differently mapped netlist (issue 17: the change had to keep it equal).
+  localparam int unsigned InW  = 1 + de_pkg::RecW;
+  // Out: ready, pixel valid, pixel, its column (de_span_array's pix_col_o), busy.
+  localparam int unsigned ColW = 12;
+  localparam int unsigned OutW = 1 + 1 + de_pkg::PixW + ColW + 1;
   localparam int unsigned Grp  = 4;
   localparam int unsigned NGrp = (NumColours * OutW + Grp - 1) / Grp;
 
@@ -48,13 +53,13 @@ module span_top #(
     de_span_array #(.NumCols(NumCols), .MaxSlots(MaxSlots)) u_span (
       .clk_i,
       .rst_i         (rst_q),
-      .instr_valid_i (in[48]),
-      .instr_ready_o (outs[c][26]),
-      .id_i          (in[47:36]),
-      .data_i        (in[35:0]),
-      .pix_valid_o   (outs[c][25]),
-      .pix_o         (outs[c][24:13]),
-      .pix_col_o     (outs[c][12:1]),
+      .instr_valid_i (in[InW-1]),
+      .instr_ready_o (outs[c][OutW-1]),
+      .id_i          (in[de_pkg::RecW-1 -: de_pkg::IdW]),
+      .data_i        (in[de_pkg::DataW-1:0]),
+      .pix_valid_o   (outs[c][OutW-2]),
+      .pix_o         (outs[c][1+ColW +: de_pkg::PixW]),
+      .pix_col_o     (outs[c][1 +: ColW]),
       .busy_o        (outs[c][0])
     );
   end

@@ -10,8 +10,8 @@
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
 rtl/array/de_chip.sv), a 1-PE chip (to separate chip overhead from the PE) and a
-what-if 9-PE chip whose PEs' bypass input is tied off (what the static configuration
-costs, which STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
+what-if 9-PE chip whose PEs' bypass input is tied off (de_chip's TieBypass = 1: what the
+static configuration costs, which STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
 the as-is 9-PE chip's fmax is below --target-mhz (default: the 640x480@60 pixel clock).
 
 `seeds` places and routes one synthesised design over several nextpnr seeds and writes
@@ -224,19 +224,6 @@ def fmax_of(rep: dict | None) -> float | None:
     return round(min(v["achieved"] for v in rep["fmax"].values()), 2)
 
 
-def nobypass_chip(out: Path) -> Path:
-    """What-if copy of de_chip.sv with the bypass tied off (every PE always used)."""
-    src = (ROOT / "rtl/array/de_chip.sv").read_text()
-    new = src.replace(".bypass_i   (pe_byp[i]),", ".bypass_i   (1'b0),")
-    new2 = new.replace(".live_i     (pe_live[i]),", ".live_i     (1'b1),")
-    if new == src or new2 == new:
-        sys.exit("nobypass what-if: de_chip.sv bypass lines changed; update flow.py")
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / "de_chip_nobypass.sv"
-    path.write_text(new2)
-    return path
-
-
 # ---------------------------------------------------------------------------- chip
 COMPACT = {"ecp5": 0, "ice40": 1}   # de_pe Compact per family (chip only)
 
@@ -249,14 +236,14 @@ def chip(args) -> int:
     for tag, npe, nobyp in variants:
         out = BUILD / f"chip_{fam}" / tag
         print(f"[{fam} {tag}] synthesis", flush=True)
-        # chip_top (for place and route) and the bare de_chip (for the resource count);
-        # the what-if variant reads its copy of de_chip.sv in place of the original.
-        swap = {"rtl/array/de_chip.sv": str(nobypass_chip(out))} if nobyp else {}
-        srcs_top = [swap.get(s, s) for s in core_srcs("fpga", "chip")]
-        srcs = [swap.get(s, s) for s in core_srcs("chip")]
+        # chip_top (for place and route) and the bare de_chip (for the resource count).
+        srcs_top = core_srcs("fpga", "chip")
+        srcs = core_srcs("chip")
         # The iCE40 HX8K is full with 9 PEs: there the PE takes the small form of its
         # timing-only logic (de_pe Compact, same cycle behaviour; docs/fpga.md 6.3).
         params = {"NumPe": npe, "Compact": COMPACT[fam]}
+        if nobyp:
+            params["TieBypass"] = 1   # de_chip's what-if parameter: bypass_i 0, live_i 1
         cells_top = yosys(tmpl, out, "chip_top", srcs_top, params)
         bare = out / "bare"
         cells_chip = yosys(tmpl, bare, "de_chip", srcs, params)

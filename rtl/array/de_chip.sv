@@ -32,7 +32,12 @@ module de_chip
   // PE's operand selects, the pixel-valid bit for the collision flag); they hold the
   // values of the registers they copy, so 0 changes no output. The FPGA builds and the
   // testbenches keep 1; the Verilated harnesses build 0 (the copies cost them 11 %).
-  parameter int unsigned TimingCopies = 1
+  parameter int unsigned TimingCopies = 1,
+  // What-if only (fpga/scripts/flow.py chip, its pe9_nobypass run): 1 = every PE's
+  // bypass_i tied to 0 and live_i to 1, so synthesis sees the static configuration as
+  // the constant it is in use (what the bypass costs, which STA cannot know is static).
+  // The configuration chain still shifts but bypasses no PE. 0 in every product.
+  parameter int unsigned TieBypass = 0
 ) (
   input  logic             clk_i,
   // Synchronous, active high: RstW registered copies of ONE reset, equal in every cycle.
@@ -77,7 +82,7 @@ module de_chip
   link_t core_link;
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask),
-                 .RstW(RstW), .TimingCopies(TimingCopies))
+                 .RstW(RstW), .TimingCopies(TimingCopies), .TieBypass(TieBypass))
   u_core (
     .clk_i, .rst_i, .link_i, .blk1z_i, .idsel_i, .chain_ctl_i, .chain_i, .chain_o,
     .bypass_o, .link_o(core_link)
@@ -102,7 +107,8 @@ module de_chip_core
   parameter int unsigned Compact   = 0,   // de_pe Compact: 1 = the smallest PE (iCE40)
   parameter logic [31:0] FaultMask = '0,
   parameter int unsigned RstW      = 1,   // copies of the reset (de_chip)
-  parameter int unsigned TimingCopies = 1   // de_chip
+  parameter int unsigned TimingCopies = 1,  // de_chip
+  parameter int unsigned TieBypass = 0      // de_chip (what-if only)
 ) (
   input  logic             clk_i,
   /* verilator lint_off UNUSEDSIGNAL */
@@ -129,6 +135,9 @@ module de_chip_core
 
   if (NumPe < 1 || NumPe > 32) begin : g_bad_num_pe
     $fatal(1, "de_chip: NumPe must be 1..32, got %0d", NumPe);
+  end
+  if (TieBypass > 1) begin : g_bad_tie_bypass
+    $fatal(1, "de_chip: TieBypass must be 0 or 1, got %0d", TieBypass);
   end
   // Copies of the reset per PE (de_pe RstW): four groups when the chip has a tree.
   localparam int unsigned PeRstW = (RstW < 4) ? RstW : 4;
@@ -188,8 +197,8 @@ module de_chip_core
             .PixCopy((Compact == 0 && TimingCopies == 1) ? 1 : 0)) u_pe (
       .clk_i,
       .rst_i      (pe_rst[i]),
-      .bypass_i   (pe_byp[i]),
-      .live_i     (pe_live[i]),
+      .bypass_i   ((TieBypass == 1) ? '0 : pe_byp[i]),
+      .live_i     ((TieBypass == 1) ? 1'b1 : pe_live[i]),
       .id_i       (bus_id[i]),
       .data_i     (bus_data[i]),
       .blk1z_i    (bus_blk1z[i]),

@@ -13,15 +13,16 @@ module de_deskew
   output logic [IdW-1:0]               id_o,
   output logic [DataW-1:0]             data_o
 );
-  logic [11:0] ident_q, ident_q2, blk0_q, blk0_q2, blk1_q;
+  logic [IdW-1:0]  ident_q, ident_q2;
+  logic [BlkW-1:0] blk0_q, blk0_q2, blk1_q;
 
   always_ff @(posedge clk_i) begin
     if (rst_i) begin
-      ident_q  <= 12'd0;
-      ident_q2 <= 12'd0;
-      blk0_q   <= 12'd0;
-      blk0_q2  <= 12'd0;
-      blk1_q   <= 12'd0;
+      ident_q  <= '0;
+      ident_q2 <= '0;
+      blk0_q   <= '0;
+      blk0_q2  <= '0;
+      blk1_q   <= '0;
     end else begin
       ident_q  <= id_i;
       ident_q2 <= ident_q;
