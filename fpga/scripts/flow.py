@@ -10,8 +10,8 @@
 
 `chip` synthesises and places-and-routes ONE 9-PE chip (fpga/chip_top.sv around
 rtl/array/de_chip.sv), a 1-PE chip (to separate chip overhead from the PE) and a
-what-if 9-PE chip whose PEs' bypass input is tied off (what the static configuration
-costs, which STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
+what-if 9-PE chip whose PEs' bypass input is tied off (de_chip's TieBypass = 1: what the
+static configuration costs, which STA cannot know is static), writes fpga/reports/chip_<family>.{json,txt} and exits 1 if
 the as-is 9-PE chip's fmax is below --target-mhz (default: the 640x480@60 pixel clock).
 
 `seeds` places and routes one synthesised design over several nextpnr seeds and writes

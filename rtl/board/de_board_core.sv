@@ -105,12 +105,19 @@ module de_board_core #(
   );
 
   // ------------------------------------------------------------------ SDRAM frame store
+  // The mode's active lines: de_pkg's table (spec/video.toml) for the fixed modes, read
+  // into constants (no logic), and the test mode's parameter; the case is the only mux
+  // (a mux of whole modes, TestMode or de_pkg::video_mode(mode_i), mapped the board to
+  // a different netlist).
+  localparam de_pkg::video_mode_t Mode0 = de_pkg::video_mode(2'd0);
+  localparam de_pkg::video_mode_t Mode1 = de_pkg::video_mode(2'd1);
+  localparam de_pkg::video_mode_t Mode2 = de_pkg::video_mode(2'd2);
   logic [11:0] vactive;
   always_comb begin
     unique case (mode_i)
-      2'd0:    vactive = 12'd480;
-      2'd1:    vactive = 12'd485;
-      2'd2:    vactive = 12'd1024;
+      2'd0:    vactive = Mode0.v_act;
+      2'd1:    vactive = Mode1.v_act;
+      2'd2:    vactive = Mode2.v_act;
       default: vactive = TestMode.v_act;
     endcase
   end

@@ -153,7 +153,7 @@ module de_display_core #(
       .ev_issue_i      (ev_issue),
       .ev_free_i       (ev_free),
       .drop_i          (drop),
-      .reg_addr_i      (reg_addr_i[11:0]),
+      .reg_addr_i      (reg_addr_i[de_pkg::RegChanLsb-1:0]),
       .reg_rdata_o     (mon_rdata[c])
     );
   end
@@ -174,9 +174,9 @@ module de_display_core #(
   logic        align_err_d, align_err_q;
 
   always_comb begin
-    reg_ch_d = reg_addr_i[13:12];
+    reg_ch_d = reg_addr_i[de_pkg::RegChanLsb +: 2];
     info_d   = 32'h0;
-    unique case (reg_addr_i[11:0])
+    unique case (reg_addr_i[de_pkg::RegChanLsb-1:0])
       // ID: [31:24] 0xDC, [23:20] channels, [19:16] NumBuf, [15:0] ArrayLatency.
       de_pkg::CtrlRegId:       info_d = {de_pkg::CtrlIdMagic, 4'(NumCh), 4'(NumBuf),
                                          16'(ArrayLatency)};

@@ -4,11 +4,14 @@ for the chip whose bypass is tied off), never a copy of an .sv file edited by
 str.replace or re.sub and written out. This test reads the flow's Python (fpga/**/*.py)
 with `ast` and fails on a script that reads an HDL file's text and substitutes in it,
 or that writes an HDL file; it is shown to catch the old flow.py's nobypass_chip.
-No tool runs."""
+No synthesis runs; verilator --lint-only checks TieBypass's elaboration check."""
 from __future__ import annotations
 
 import ast
+import importlib.util
 import re
+import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -154,3 +157,22 @@ def test_the_what_if_chip_is_a_de_chip_parameter():
     for top in ("rtl/array/de_chip.sv", "fpga/chip_top.sv"):
         assert re.search(r"parameter int unsigned TieBypass\s*=\s*0\b",
                          (ROOT / top).read_text()), top
+
+
+@pytest.mark.parametrize("value,ok", [(0, True), (1, True), (2, False)])
+def test_tie_bypass_is_checked_at_elaboration(value, ok, tmp_path):
+    """de_chip lints clean (-Wall) with TieBypass 0 and 1 and refuses any other value
+    (docs/style.md's g_bad_ idiom), on the files flow.py synthesises."""
+    vl = shutil.which("verilator")
+    assert vl, "verilator not on PATH"
+    spec = importlib.util.spec_from_file_location("de_fpga_flow_src", ROOT / "fpga/scripts/flow.py")
+    flow = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(flow)
+    r = subprocess.run([vl, "--lint-only", "-Wall", f"-GTieBypass={value}", "--top-module",
+                        "de_chip", *flow.core_srcs("chip"), "--Mdir", str(tmp_path)],
+                       capture_output=True, text=True, cwd=ROOT)
+    if ok:
+        assert r.returncode == 0, r.stderr
+    else:
+        assert r.returncode != 0, f"TieBypass={value} elaborated"
+        assert "TieBypass must be 0 or 1, got 2" in r.stderr, r.stderr

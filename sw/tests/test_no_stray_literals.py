@@ -152,11 +152,7 @@ PLACES: list[tuple[str, tuple[re.Pattern, ...]]] = [
 # Hits in synthesised RTL that is changed only with a netlist comparison proving the
 # change a refactor: file:line -> who is fixing it. An entry that no longer hits fails
 # test_pending_hits_are_still_there, so the list shrinks as the fixes land.
-_RTL31 = "helper rtl31 (branch rtl31): de_pkg word_blk / rec_id / video_mode, netlist EQUAL"
 PENDING: dict[str, str] = {
-    "rtl/board/de_board_core.sv:111": _RTL31,   # vactive 12'd480
-    "rtl/board/de_board_core.sv:112": _RTL31,   # vactive 12'd485
-    "rtl/board/de_board_core.sv:113": _RTL31,   # vactive 12'd1024
     # the 7.7 compensation: {int_wide[DataW-1:FracW], 1'b0, int_wide[FracW-1:1]} would do;
     # found by lit31 (11-26), assigned to nobody yet (reported to the lead)
     "rtl/proto/de_data_mapper.sv:50": "unassigned: synthesised, needs a netlist comparison",

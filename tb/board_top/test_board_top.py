@@ -37,6 +37,11 @@ checks, exactly:
     command errors exactly as injected; no late line for want of data), the controller
     ID and the Load Monitors' late-line and dropped-word totals (0) read over the UART;
   * the SDRAM model saw 0 timing violations and the controller refreshed.
+The random lines keep to LINE_BUDGET words (the fetch budget of this build, below).
+
+test_fetch_budget (same toplevel): every line of all three colours LINE_BUDGET words is
+on time for 48 frames and shows the golden image; one word more is late, and counted.
+
 Parametrised runs: plain (78.125 MHz / 3 Mbaud, divider error 0.16 %), nearlimit
 (76.5 MHz / 3 Mbaud: divider 26 is 1.96 % slow against the host's exact 3 Mbaud, just
 under the 2 % elaboration limit), span (span-serial arrays; UART at 256.4 MHz).
@@ -74,6 +79,15 @@ NCH = 3
 PIX_PS = 40000          # pixel clock period (25 MHz)
 SD_PS = 8000            # SDRAM clock period (125 MHz)
 MARKER = 0x0800_0000    # the end-of-line marker (REFRESH, LUT code 1), operand 0
+# Frame-store words per line per colour (marker included) that the board, as built here
+# (PfDepth 16), fetches in time in the test mode's 17-clock lines: a colour may have only
+# PfDepth - 8 = 8 words requested and not yet taken by its player (de_frame_fetch's
+# credit), and a burst's words reach the player some 7 pixel clocks after its request,
+# so a colour gets about 8 words per 11 pixel clocks, ~12 per line. test_fetch_budget
+# pins the boundary: 12 in every line of all three colours are on time, 13 are late. The
+# random images keep to it (the board's 2,048-word FIFOs have no such limit: docs/board.md
+# §5). A change to the fetch path's latency or to PfDepth moves it.
+LINE_BUDGET = 12
 
 
 # ====================================================================== TMDS encoder
@@ -178,7 +192,8 @@ def fs_quantise(cmd: isa.Command, w: int, rng: random.Random) -> isa.Command:
 
 
 def make_image(rng: random.Random, g: dict, w: int, max_words: int) -> list[isa.Command]:
-    """VActive lines of random commands, at most max_words frame-store words per line."""
+    """VActive lines of random commands, at most max_words frame-store words per line
+    before its marker."""
     cmds = []
     for _ in range(g["TestVActive"]):
         line, n = [], 0
@@ -396,7 +411,7 @@ def change_lines(rng, g, words: list[int], window: int, n: int) -> list[int]:
     """The frame with n random lines replaced by new random lines."""
     lines = split_lines(words)
     for v in rng.sample(range(len(lines)), n):
-        cmds = make_image(rng, g, window, max_words=g["HTotal"] - 4)
+        cmds = make_image(rng, g, window, max_words=LINE_BUDGET - 1)
         lines[v] = split_lines(binfmt.framestore_encode(cmds, window))[v]
     return [w for ln in lines for w in ln]
 
@@ -421,7 +436,7 @@ async def test_load_and_play(dut):
     for _ in range(20):
         fw = [[], [], []]          # fw[f][c]: frame-store words
         for c in range(NCH):
-            cmds = make_image(rng, g, windows[c], max_words=g["HTotal"] - 4)
+            cmds = make_image(rng, g, windows[c], max_words=LINE_BUDGET - 1)
             fw[0].append(binfmt.framestore_encode(cmds, windows[c]))
         for f in (1, 2):
             fw[f] = [change_lines(rng, g, fw[f - 1][c], windows[c], 2) for c in range(NCH)]
@@ -568,6 +583,101 @@ async def test_load_and_play(dut):
                   f"{nref} refreshes; registers {dict((k, hex(v)) for k, v in regs.items())}")
 
 
+# ====================================================================== fetch budget
+def uniform_frame(rng: random.Random, g: dict, w: int, n: int) -> list[int]:
+    """Frame-store words of a frame whose VActive lines are one line of exactly n words
+    (n - 1 words of random commands on the grid, topped up with Nops, then the marker):
+    frame_pack stores the line once, so it loads in a few packets, and the fetcher still
+    reads it once per line."""
+    line, k = [], 0
+    while k < n - 1:
+        c = fs_quantise(randgen.command(rng, g["n_pe"]), w, rng)
+        if k + len(isa.slots(c)) > n - 1:
+            c = isa.Command("NOP")
+        line.append(c)
+        k += len(isa.slots(c))
+    words = binfmt.framestore_encode((line + [isa.Command("REFRESH")]) * g["TestVActive"], w)
+    assert [len(ln) for ln in split_lines(words)] == [n] * g["TestVActive"]
+    return words
+
+
+async def late_counts(host: Host) -> dict:
+    """Status byte 15 (late lines for want of SDRAM data) and the Load Monitors' late
+    lines and dropped words per colour (registers 0x00A, 0x009)."""
+    st = await host.command(with_chk(b"S"), n_reply=16)
+    assert st[0] == ord("S"), st
+    out = {"starved": st[15]}
+    for c in range(NCH):
+        for name, reg in (("late", 0x00A), ("drop", 0x009)):
+            r = await host.command(with_chk(b"R" + (c << 12 | reg).to_bytes(2, "big")),
+                                   n_reply=5)
+            assert r[0] == ord("R"), r
+            out[f"{name}{c}"] = int.from_bytes(r[1:], "big")
+    return out
+
+
+@cocotb.test()
+async def test_fetch_budget(dut):
+    """The boundary of LINE_BUDGET: all three colours at LINE_BUDGET words in every line
+    are on time over 48 frames (the refresh, every 182.4 pixel clocks, walks through the
+    187-clock frame in 40), every frame after the switch the golden image; one word more
+    per line is late, and every late line is counted (status byte 15, the Load Monitors'
+    late lines and dropped words), none silently; the frames it spoils are reported."""
+    from common.run import seed_from_env
+    rng = random.Random(seed_from_env())
+    g = geom(dut)
+    await reset(dut, g)
+    host = Host(dut, g)
+    video = Video(dut, g)
+    va, ftime = g["TestVActive"], g["HTotal"] * g["VTotal"]
+    windows, comps = [2, 0, 4], [True, True, False]
+    shift, sat = 1, True
+    sizes = (LINE_BUDGET, LINE_BUDGET + 1)
+    fw = [[uniform_frame(rng, g, windows[c], n) for c in range(NCH)] for n in sizes]
+    imgs = [[golden(binfmt.encode_de32(fw[f][c], windows[c], comps[c]), g, shift, sat)
+             for c in range(NCH)] for f in range(2)]
+    plan = frame_pack.pack([[(fw[f][c], windows[c], comps[c]) for c in range(NCH)]
+                            for f in range(2)], va)
+    video.on = True
+    assert await host.command(with_chk(b"O" + bytes([shift, int(sat)]))) == b"K"
+    for ch, off, words in plan.writes:
+        await host.load(ch, off, words)
+    for ch, slot, toff, window, comp in plan.slots:
+        assert await host.command(cmd_f(ch, slot, toff, window, comp)) == b"K"
+
+    # At the budget: Q(0, 1), 48 frames.
+    n0 = len(video.frames())
+    assert await host.command(cmd_q(0, 1, 1, False)) == b"K"
+    await ClockCycles(dut.clk_i, 48 * ftime)
+    shown = video.frames()[n0:]
+    at = await late_counts(host)
+    assert all(v == 0 for v in at.values()), f"{sizes[0]} words a line: late {at}"
+    black = [np.zeros((va, g["n_pe"]), np.uint8)] * NCH
+    check_switch(shown, black, imgs[0], f"{sizes[0]} words a line")
+    n_ok = sum(1 for f in shown if frame_index(f, imgs[:1]) == [0])
+    assert n_ok >= 40, f"{sizes[0]} words a line: the image shown {n_ok} times"
+
+    # One word beyond: Q(1, 1), 16 frames; the late lines show and are counted.
+    n1 = len(video.frames())
+    assert await host.command(cmd_q(1, 1, 1, False)) == b"K"
+    await ClockCycles(dut.clk_i, 16 * ftime)
+    shown1 = video.frames()[n1:]
+    over = await late_counts(host)
+    late = sum(over[f"late{c}"] for c in range(NCH))
+    drop = sum(over[f"drop{c}"] for c in range(NCH))
+    assert over["starved"] > 0 and late >= over["starved"] and drop > 0, (
+        f"{sizes[1]} words a line: not late (LINE_BUDGET too low?) or late lines not "
+        f"counted: {over}")
+    # How many frames the late lines spoil depends on the words cut (Nops, or pixels the
+    # output window clips, change nothing): counted above, reported here.
+    bad = sum(1 for f in shown1 if not frame_index(f, imgs))   # neither image
+    nerr = int(dut.err_count_o.value)
+    assert nerr == 0, f"the SDRAM model saw {nerr} timing violations"
+    dut._log.info(f"fetch budget: {sizes[0]} words a line in all three colours on time, "
+                  f"{n_ok} frames equal to the image; {sizes[1]} words a line: {over}, "
+                  f"{bad} of {len(shown1)} frames wrong")
+
+
 # ====================================================================== board shell
 @cocotb.test()
 async def test_shell_serialiser(dut):
@@ -671,6 +781,13 @@ def test_board(kind):
                            UartClkHz=256_410_256)}[kind]
     build_and_test(HERE, "tb_board_sdram", board_sources(), "test_board_top",
                    parameters=params, testcase="test_load_and_play")
+
+
+def test_budget():
+    """The fetch budget's boundary (LINE_BUDGET), on the plain board of test_board."""
+    from common.run import build_and_test
+    build_and_test(HERE, "tb_board_sdram", board_sources(), "test_board_top",
+                   parameters=BOARD, testcase="test_fetch_budget")
 
 
 def test_shell():

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import random
+from fractions import Fraction
 from pathlib import Path
 
 import cocotb
@@ -76,13 +77,17 @@ class Bench:
                 await FallingEdge(d.clk_i)
             await self.offer(ident, data)
 
-    async def play_paced(self, slots, rate: int, htotal: int):
+    async def play_paced(self, slots, rate, htotal: int):
         """The display's bus: slot k of a line of `htotal` slots (Nops pad each line) is
-        due at clock k * rate. A slot the array does not take in time waits (in hardware:
-        a FIFO in front); returns the clocks at which each Refresh was due and the
-        largest backlog in slots."""
+        due at clock floor(k * rate) (span_timing.slot_due: `rate` may be a Fraction, the
+        board's 25/8 core clocks per pixel clock). A slot the array does not take in time
+        waits (in hardware: a FIFO in front); returns the clocks at which each Refresh was
+        due and the largest backlog in slots. self.offered gets the clock (from the first
+        slot's due time) at which each slot was first offered."""
+        from diffengine.bench.span_timing import last_due, slot_due
         d = self.dut
         due_refresh, backlog, k, base = [], 0, 0, self.cycle
+        self.offered = []
         line: list = []
         lines = []
         for ident, data in slots:
@@ -93,12 +98,14 @@ class Bench:
         for ln in lines:
             assert len(ln) == htotal, f"a line of {len(ln)} slots: more than HTotal {htotal}"
             for ident, data in ln:
-                while self.cycle < base + k * rate:
+                due = slot_due(k, rate)
+                while self.cycle < base + due:
                     await FallingEdge(d.clk_i)
                 # Slots due but not yet taken: how far the array is behind the bus.
-                backlog = max(backlog, (self.cycle - base) // rate - k)
+                backlog = max(backlog, last_due(self.cycle - base, rate) - k)
                 if ident == isa.REFRESH:
-                    due_refresh.append(base + k * rate)
+                    due_refresh.append(base + due)
+                self.offered.append(self.cycle - base)
                 await self.offer(ident, data)
                 k += 1
         return due_refresh, backlog
@@ -314,6 +321,40 @@ async def figure_lists(dut):
     b.check(cmds, bug())
 
 
+@cocotb.test()
+async def paced_driver(dut):
+    """The paced driver (play_paced, what `diffengine bench span` measures the lag with):
+    on a light stream the array never holds a slot back, so slot k must be offered at
+    exactly floor(k * ratio) clocks after the first: 0, 3, 6, 9, 12, 15, 18, 21, 25, ...
+    at the board's 25/8, k * 3 at ratio 3 (the old integer pacer), 0, 3, 6, 10, ... at
+    10/3; no backlog, and the frame equals the functional model."""
+    b = await start(dut)
+    n = b.n
+    while int(dut.busy_o.value):          # the reset sweep
+        await FallingEdge(dut.clk_i)
+    htotal = 40                           # slots per line; a line >= 120 clocks > the drain
+    cmds = []
+    for ratio in (Fraction(25, 8), Fraction(3), Fraction(10, 3)):
+        part = []
+        for y in range(4):
+            part += [isa.Command("EVAL", (3 * y) % n, 2, (ONE // (y + 2), ONE // 64)),
+                     isa.Command("SETI", n - 3, 2, (ONE // 3,)),
+                     isa.Command("EVAL0", 1, 1, (40 + y,)), isa.Command("REFRESH")]
+        cmds += part
+        slots = isa.serialise(part)
+        _, backlog = await b.play_paced(slots, ratio, htotal)
+        await b.drain()
+        want = [int(k * ratio.numerator / ratio.denominator) for k in range(len(b.offered))]
+        assert len(b.offered) == 4 * htotal, f"{len(b.offered)} slots offered"
+        bad = [k for k, (o, w) in enumerate(zip(b.offered, want)) if o != w]
+        assert not bad, (f"ratio {ratio}: slot {bad[0]} offered at clock {b.offered[bad[0]]}, "
+                         f"due at floor({bad[0]} x {ratio}) = {want[bad[0]]}")
+        assert backlog == 0, f"ratio {ratio}: backlog {backlog} on a light stream"
+        dut._log.info(f"ratio {ratio}: {len(want)} slots at floor(k x ratio), first "
+                      f"{b.offered[:10]}")
+    b.check(cmds, bug())
+
+
 @cocotb.test(skip=not os.environ.get("DE_SPAN_STREAM"))
 async def stream_file(dut):
     """A whole .de48 frame (DE_SPAN_STREAM) as fast as the array takes it: the frame must
@@ -323,7 +364,8 @@ async def stream_file(dut):
     path = Path(os.environ["DE_SPAN_STREAM"])
     slots = binfmt.decode_de48(path.read_bytes(), str(path))
     cmds = binfmt.deserialise(slots, str(path))
-    rate = int(os.environ.get("DE_SPAN_RATE", "0"))
+    # DE_SPAN_RATE: core clocks per slot, "3", "3.125" or "25/8"; 0 = unpaced.
+    rate = Fraction(os.environ.get("DE_SPAN_RATE", "0"))
     b = await start(dut)
     while int(dut.busy_o.value):          # the reset sweep
         await FallingEdge(dut.clk_i)
@@ -332,12 +374,12 @@ async def stream_file(dut):
            "forward": int(dut.Forward.value), "prefetch": int(dut.Prefetch.value),
            "pass_aw": int(dut.PassAw.value)}
     if rate:
-        # Paced like the display's bus: HTotal slots per line, one per `rate` clocks.
+        # Paced like the display's bus: HTotal slots per line, slot k at floor(k * rate).
         htotal = int(os.environ.get("DE_SPAN_HTOTAL", 800))
         due, backlog = await b.play_paced(slots, rate, htotal)
         await b.drain()
         lag = [e - d for e, d in zip(b.refresh_cycles, due)]
-        res.update(rate=rate, htotal=htotal, backlog_slots=backlog,
+        res.update(rate=str(rate), htotal=htotal, backlog_slots=backlog,
                    lag_clocks=lag)
         msg = (f"paced at 1 slot / {rate} clocks: last pixel of a line at most {max(lag)} "
                f"clocks after its Refresh was due, backlog at most {backlog} slots")

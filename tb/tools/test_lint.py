@@ -31,10 +31,7 @@ def test_every_waiver_gives_a_reason():
 
 # RTL files that still lack the `default_nettype pair, each with why it is not fixed here.
 # The test fails when one is fixed (take it out) or another appears.
-NETTYPE_PENDING = {
-    "rtl/board/de_uart_pkg.sv": "synthesised RTL: the two lines are described in the "
-                                "issue-17 audit report, to be added with the next board change",
-}
+NETTYPE_PENDING: dict[str, str] = {}
 
 
 def _rtl_sources() -> list[Path]:

@@ -16,7 +16,8 @@ BENCHES = [
      "the CAD drag, against --baseline-rev"),
     ("array", ".array", "Verilated array speed (1/8/72 chips) against the baseline revision"),
     ("span", ".span", "span-serial array: clocks per line on the teapot and CAD frames, "
-     "and the levers against the line budget"),
+     "unpaced and paced at the board's clock ratio (25/8); exit 1 unless the worst line is "
+     "at most 90 per cent of the line and no paced line is later than SpanLatency"),
     ("recon", ".recon", "image reconstruction report -> docs/reconstruction.md"),
     ("recon-images", ".recon_images", "the reconstruction test images -> sw/images"),
     ("viewer", ".viewer", "viewer: pointer-to-frame latency of a scripted drag (teapot, CAD)"),

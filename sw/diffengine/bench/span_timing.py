@@ -10,11 +10,15 @@ checked against that RTL's clocks per line there (same streams, same run). Optio
             backlog leaves 0; the cocotb driver used to leave 1);
   prefetch  the RTL's Prefetch: no load clock between passes;
   fwd       the RTL's Forward ("rtl"), or none, or an ideal bypass (never a wait);
-  engines   more engines per colour over disjoint column ranges (an estimate).
+  engines   more engines per colour over disjoint column ranges (an estimate);
+  rate      paced like the display's bus: one slot per `rate` core clocks on average,
+            a Fraction (the board's 25/8) or an integer; slot k is due at clock
+            floor(k * rate) (slot_due), the pacer tb/de_span_array's driver uses too.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 from .. import isa
 
@@ -27,6 +31,36 @@ class Pass:
     rfr: bool
     cols: list          # the columns the pass walks, in order
     nslot: int
+
+
+def parse_ratio(text) -> Fraction:
+    """A clock ratio (core clocks per pixel clock) from "3", "3.125" or "25/8" (or an int
+    or Fraction), exactly; ValueError with a message naming the text if it is not a
+    number of at least 1 (the array takes at most one slot per core clock)."""
+    try:
+        r = Fraction(text.strip()) if isinstance(text, str) else Fraction(text)
+    except (ValueError, TypeError, ZeroDivisionError):
+        raise ValueError(f"clock ratio {text!r}: not a number (give e.g. 3, 3.125 or 25/8)") \
+            from None
+    if r < 1:
+        raise ValueError(f"clock ratio {text!r}: below 1 (the array takes one slot per "
+                         f"core clock at most)")
+    return r
+
+
+def slot_due(k: int, rate) -> int:
+    """The core clock (from the first slot's) at which slot k of the paced bus is due:
+    floor(k * rate), exact for a fractional rate (25/8: 0, 3, 6, 9, 12, 15, 18, 21, 25)."""
+    r = Fraction(rate)
+    return k * r.numerator // r.denominator
+
+
+def last_due(t: int, rate) -> int:
+    """The last slot due by clock t: the largest j with slot_due(j) <= t, i.e.
+    ceil((t + 1) / rate) - 1 (t // rate for an integer rate). The backlog while slot k
+    waits at clock t is last_due(t) - k."""
+    r = Fraction(rate)
+    return -(-(t + 1) * r.denominator // r.numerator) - 1
 
 
 def passes_of(slots, ncols: int = 648, max_slots: int = K_DEFAULT) -> list[list[Pass]]:
@@ -53,16 +87,16 @@ def _paced(slots, htotal: int):
             line.append(sl)
 
 
-def _front_end(slots, ncols: int, k: int, gap: int, room=None, rate: int = 0,
+def _front_end(slots, ncols: int, k: int, gap: int, room=None, rate=0,
                htotal: int = 800, stats: dict | None = None):
     """The passes in stream order with the clock each is written into the pass table
     (commit; a Refresh is written when it is taken) and the index of its line. The front
     end takes a slot a clock (plus `gap` idle clocks of the driver after each) and
     spends a clock on each commit of a pending group (the slot that closes it waits).
     room(i): the first clock pass i finds a free table entry. rate: slot j of the padded
-    stream is due at clock j * rate (paced like the bus; a slot not taken when due waits,
-    and waiting slots go in back to back); stats gets the largest backlog in slots and
-    the clock each Refresh was due."""
+    stream is due at clock slot_due(j, rate) (paced like the bus; a slot not taken when
+    due waits, and waiting slots go in back to back); stats gets the largest backlog in
+    slots and the clock each Refresh was due."""
     t, line, n = 0, 0, 0
     open_, pend_cols, nslot, eff = False, None, 0, 0
     stats = stats if stats is not None else {}
@@ -73,7 +107,7 @@ def _front_end(slots, ncols: int, k: int, gap: int, room=None, rate: int = 0,
 
     src = _paced(slots, htotal) if rate else slots
     for j, (ident, data) in enumerate(src):
-        due = j * rate
+        due = slot_due(j, rate) if rate else 0
         t = max(t, due)
         addr = bool(ident & isa.ID_ADDR)
         ref = bool(ident & isa.ID_REFRESH) and not addr
@@ -104,13 +138,13 @@ def _front_end(slots, ncols: int, k: int, gap: int, room=None, rate: int = 0,
                 n += 1
                 line += 1
         if rate:
-            stats["backlog"] = max(stats["backlog"], t // rate - j)
+            stats["backlog"] = max(stats["backlog"], last_due(t, rate) - j)
         t += 1 + gap
 
 
 def simulate(slots, ncols: int = 648, k: int = K_DEFAULT, *, gap: int = 0,
              prefetch: bool = False, fwd: str = "none", engines: int = 1,
-             table: int = NPASS, rate: int = 0, htotal: int = 800,
+             table: int = NPASS, rate=0, htotal: int = 800,
              stats: dict | None = None) -> list[int]:
     """Clocks per line (from one Refresh token's issue to the next) of de_span_array fed
     `slots` back to back (gap 0) or with `gap` idle clocks after each slot.
