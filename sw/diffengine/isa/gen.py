@@ -3,6 +3,9 @@
     python -m diffengine.isa.gen            write the generated files
     python -m diffengine.isa.gen --check    regenerate in memory, diff, exit 1 on a difference
     python -m diffengine.isa.gen --out DIR  write under DIR instead of the repository
+    python -m diffengine.isa.gen --spec-root DIR   read DIR/spec/*.toml instead
+
+A spec file that is not valid TOML stops it with FILE:LINE:COL: and exit status 1.
 
 Outputs (paths relative to the repository root, each with a do-not-edit header):
 rtl/xproc/de_pkg.sv (SystemVerilog package de_pkg), sw/include/de_isa.h (C) and
