@@ -47,7 +47,7 @@ module de_data_mapper
     // Eval0 intensity: 7 bits (sign + 6 window bits) placed at pixel bits [w+6:w].
     i12 = {{5{operand[26]}}, operand[26:20]} << w;
     // 7.7: halve the 24-bit fraction so a fraction overflow (+2 under the fault) means 1.0.
-    comp = {int_wide[35:24], 1'b0, int_wide[23:1]};
+    comp = {int_wide[DataW-1:FracW], 1'b0, int_wide[FracW-1:1]};
 
     // An idle cycle enters the array as a Nop.
     ident_d = valid_i ? ident : IdNop;

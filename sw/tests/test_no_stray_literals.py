@@ -163,11 +163,7 @@ PLACES: list[tuple[str, tuple[re.Pattern, ...]]] = [
 # Hits in synthesised RTL that is changed only with a netlist comparison proving the
 # change a refactor: file:line -> who is fixing it. An entry that no longer hits fails
 # test_pending_hits_are_still_there, so the list shrinks as the fixes land.
-PENDING: dict[str, str] = {
-    # the 7.7 compensation: {int_wide[DataW-1:FracW], 1'b0, int_wide[FracW-1:1]} would do;
-    # found by lit31 (11-26), assigned to nobody yet (reported to the lead)
-    "rtl/proto/de_data_mapper.sv:50": "unassigned: synthesised, needs a netlist comparison",
-}
+PENDING: dict[str, str] = {}
 
 
 def _blank_c_comments(text: str) -> str:
