@@ -1,7 +1,11 @@
 /* yproc.h - the y-processor (docs/yproc.md, docs/shading.md): the visible
  * domains of the HSR (sw/hsr) scan-converted and shaded into per-scanline
  * x-processor command streams; plus the .anim reader of the incremental
- * pipeline.  One public header; errors are hsr_status codes.  Prefix yp_. */
+ * pipeline.  One public header; errors are hsr_status codes.  Prefix yp_.
+ * What the array makes of a stream is not modelled here: yp_simulate_line
+ * runs the serialised words through sw/fmodel (fmodel.h), the one C model of
+ * the x-processor, which sw/tests/test_fmodel.py holds equal to the numpy
+ * golden model (sw/diffengine/model). */
 #ifndef YPROC_H
 #define YPROC_H
 #include "hsr.h"
