@@ -1,7 +1,11 @@
 /* yproc.h - the y-processor (docs/yproc.md, docs/shading.md): the visible
  * domains of the HSR (sw/hsr) scan-converted and shaded into per-scanline
  * x-processor command streams; plus the .anim reader of the incremental
- * pipeline.  One public header; errors are hsr_status codes.  Prefix yp_. */
+ * pipeline.  One public header; errors are hsr_status codes.  Prefix yp_.
+ * What the array makes of a stream is not modelled here: yp_simulate_line
+ * runs the serialised words through sw/fmodel (fmodel.h), the one C model of
+ * the x-processor, which sw/tests/test_fmodel.py holds equal to the numpy
+ * golden model (sw/diffengine/model). */
 #ifndef YPROC_H
 #define YPROC_H
 #include "hsr.h"
@@ -100,9 +104,14 @@ void yp_frame_free(yp_frame *f);
  * replaced).  Every line starts with the background term. */
 hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o,
                    int y0, int y1, yp_frame *fr);
-/* Run the commands of one line through the x-processor semantics of
- * docs/isa.md section 6 (the subset yp emits): 12-bit pixels, width px. */
-void yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix);
+/* The 12-bit pixels pix[0..width-1] the commands of one line give on the array: the
+ * list is serialised as yp_write_de48 writes it (with its Refresh) and run through
+ * sw/fmodel (fmodel.h, fm_render), the functional model of docs/isa.md section 6 that
+ * sw/tests/test_fmodel.py holds equal to the numpy golden model; the correct adder (no
+ * carry bug).  yproc has no x-processor model of its own.  HSR_EINVAL for a NULL
+ * argument, a width outside 1..FM_MAX_WIDTH or a Refresh inside the list (a list is one
+ * line), HSR_ENOMEM when out of memory; on any error pix is all 0 (a black line). */
+hsr_status yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix);
 /* Streams: .de48 (docs/formats.md section 2) and .cmd text (docs/isa.md
  * section 9, exact hex); each line is followed by a Refresh. */
 hsr_status yp_write_de48(const yp_frame *fr, int colour, const char *path);

@@ -1,19 +1,24 @@
 /* yp_emit.c - command lists, their serialisation (Table 7.2 as in
  * docs/isa.md section 2/3, byte for byte what diffengine's isa.serialise
- * produces), the .cmd text form, and a small x-processor model of the
- * commands yp emits (used for the expected frame and the tests). */
-#define _POSIX_C_SOURCE 200809L   /* flockfile, putc_unlocked */
+ * produces), the .cmd text form, and the pixels a line's commands give
+ * (yp_simulate_line: the serialised words through sw/fmodel, the functional
+ * model of the array; yproc keeps no model of the x-processor of its own). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "yp_internal.h"
 #include "de_isa.h"
+#include "fmodel.h"
 
 #define M36 DE_WORD_MASK
 /* The expected frame is the correct adder's (the product); the prototype's carry fault
- * is reproduced by the RTL's CarryBug=1 and the golden model, through the same
- * de_add_word generated from spec/isa.toml. */
+ * is reproduced by the RTL's CarryBug=1, the golden model and sw/fmodel (its carry_bug
+ * argument), through the same de_add_word generated from spec/isa.toml. */
 #define YP_CARRY_BUG 0
+/* bytes of one instruction word (a .de48 slot) */
+#define YP_WORD_BYTES (DE_RECORD_BITS / 8)
+/* the most slots one command takes: an Eval of order 2 (address, 3 values, ACC) */
+#define YP_MAX_CMD_SLOTS 5
 
 int yp_cmd_slots(const yp_cmd *c)
 {
@@ -85,87 +90,77 @@ void yp_frame_free(yp_frame *f)
     free(f->line); free(f->st); free(f->ideal); free(f);
 }
 
-/* ---- x-processor model (docs/isa.md section 6), per line ------------- */
-void yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix)
-{
-    uint64_t *D = calloc((size_t)width, sizeof(uint64_t)), *R = calloc(3 * (size_t)width, sizeof(uint64_t));
-    unsigned char *fl = calloc((size_t)width, 1);   /* bit 0..2 protect A,B,C; 3 dis; 4 lock */
-    if (!D || !R || !fl) { free(D); free(R); free(fl); memset(pix, 0, sizeof(uint16_t) * (size_t)width); return; }
-    int accm = 0;
-    for (int i = 0; i < l->n; i++) {
-        const yp_cmd *c = &l->c[i];
-        int a = c->x, e = c->x + c->dx;
-        if (e > width) e = width;
-        switch (c->op) {
-        case YP_ACCMODE: accm = (int)c->v[0]; break;
-        case YP_DIS: for (int p = a; p < e; p++) fl[p] |= 8; break;
-        case YP_SETI: case YP_SETDI: case YP_SETDDI: {
-            int r = c->op - YP_SETI;
-            for (int p = a; p < e; p++) { R[3 * p + r] = (uint64_t)c->v[0]; fl[p] |= (unsigned char)(1 << r); }
-            break;
-        }
-        case YP_EVAL0:
-            for (int p = a; p < e; p++) {
-                if (!(fl[p] & 0x18)) { D[p] = (uint64_t)c->v[0] << DE_FRAC_BITS; fl[p] |= 16; }
-                fl[p] &= (unsigned char)~0x0f;
-            }
-            break;
-        case YP_EVAL: {
-            /* incoming values highest order first: in[0] = I, in[1] = dI, in[2] = ddI */
-            uint64_t in[3] = {(uint64_t)c->v[0], (uint64_t)c->v[1], (uint64_t)c->v[2]};
-            int ord = c->order;
-            for (int p = a; p < e; p++) {
-                uint64_t v[3];
-                for (int r = ord; r >= 0; r--) v[r] = (fl[p] & (1 << r)) ? R[3 * p + r] : in[r];
-                for (int r = 0; r <= ord; r++) R[3 * p + r] = v[r];
-                uint64_t A = v[0] & M36;
-                int neg = (int)((A >> (DE_WORD_BITS - 1)) & 1);
-                if (!(fl[p] & 0x18) && !(accm && neg)) D[p] = de_add_word(D[p], A, YP_CARRY_BUG);
-                fl[p] &= (unsigned char)~0x0f;
-                for (int r = 0; r < ord; r++) in[r] = de_add_word(v[r], v[r + 1], YP_CARRY_BUG);
-                in[ord] = v[ord];
-            }
-            break;
-        }
-        default: break;
-        }
-    }
-    for (int p = 0; p < width; p++) pix[p] = (uint16_t)(((D[p] & M36) >> DE_FRAC_BITS) & DE_BLOCK_MASK);
-    free(D); free(R); free(fl);
-}
-
 /* ---- serialisation -------------------------------------------------- */
-static void put48(FILE *f, unsigned ident, uint64_t data)
+/* one 48-bit instruction word at o (big-endian: identifier in bits 47..36, data in
+ * 35..0); returns the end */
+static uint8_t *put48(uint8_t *o, unsigned ident, uint64_t data)
 {
     uint64_t w = ((uint64_t)(ident & DE_ID_MASK) << DE_WORD_BITS) | (data & M36);
-    /* the caller holds f's lock (flockfile): a byte at a time without one fwrite
-     * (and its lock) per 6-byte word, which cost the viewer ~5 ms a frame */
-    for (int i = 0; i < DE_RECORD_BITS / 8; i++) putc_unlocked((int)(unsigned char)(w >> (DE_RECORD_BITS - 8 - 8 * i)), f);
+    for (int i = 0; i < YP_WORD_BYTES; i++) o[i] = (uint8_t)(w >> (DE_RECORD_BITS - 8 - 8 * i));
+    return o + YP_WORD_BYTES;
 }
 
-static void put_cmd(FILE *f, const yp_cmd *c)
+/* the words of one command (at most YP_MAX_CMD_SLOTS, yp_cmd_slots of them; none for
+ * an unknown op) at o; returns the end */
+static uint8_t *put_cmd(uint8_t *o, const yp_cmd *c)
 {
     uint64_t rng = (uint64_t)(c->x & DE_BLOCK_MASK) | ((uint64_t)(c->dx & DE_BLOCK_MASK) << DE_BLOCK_BITS);
     switch (c->op) {
-    case YP_REFRESH: put48(f, DE_ID_REFRESH, 0); break;
-    case YP_ACCMODE: put48(f, c->v[0] ? DE_ID_ACCMODE_ON : DE_ID_ACCMODE_OFF, 0); break;
-    case YP_DIS: put48(f, DE_ID_ADDR_DIS, rng); break;
-    case YP_EVAL0: put48(f, DE_ID_ADDR_EVAL0, rng | ((uint64_t)(c->v[0] & DE_BLOCK_MASK) << (2 * DE_BLOCK_BITS))); break;
+    case YP_REFRESH: return put48(o, DE_ID_REFRESH, 0);
+    case YP_ACCMODE: return put48(o, c->v[0] ? DE_ID_ACCMODE_ON : DE_ID_ACCMODE_OFF, 0);
+    case YP_DIS: return put48(o, DE_ID_ADDR_DIS, rng);
+    case YP_EVAL0: return put48(o, DE_ID_ADDR_EVAL0, rng | ((uint64_t)(c->v[0] & DE_BLOCK_MASK) << (2 * DE_BLOCK_BITS)));
     case YP_SETI: case YP_SETDI: case YP_SETDDI: {
         static const unsigned set_id[3] = {DE_ID_SET_A, DE_ID_SET_B, DE_ID_SET_C};
-        put48(f, DE_ID_ADDR_RANGE, rng); put48(f, set_id[c->op - YP_SETI], (uint64_t)c->v[0]);
-        break;
+        o = put48(o, DE_ID_ADDR_RANGE, rng);
+        return put48(o, set_id[c->op - YP_SETI], (uint64_t)c->v[0]);
     }
-    case YP_EVAL: {
-        put48(f, DE_ID_ADDR_RANGE, rng);
-        if (c->order == 0) put48(f, DE_ID_D_A, (uint64_t)c->v[0]);
-        else if (c->order == 1) { put48(f, DE_ID_D_B, (uint64_t)c->v[1]); put48(f, DE_ID_D_A_B, (uint64_t)c->v[0]); }
-        else { put48(f, DE_ID_D_C, (uint64_t)c->v[2]); put48(f, DE_ID_D_B_C, (uint64_t)c->v[1]); put48(f, DE_ID_D_A_B, (uint64_t)c->v[0]); }
-        put48(f, DE_ID_ACC, 0);
-        break;
+    case YP_EVAL:
+        o = put48(o, DE_ID_ADDR_RANGE, rng);
+        if (c->order == 0) o = put48(o, DE_ID_D_A, (uint64_t)c->v[0]);
+        else if (c->order == 1) { o = put48(o, DE_ID_D_B, (uint64_t)c->v[1]); o = put48(o, DE_ID_D_A_B, (uint64_t)c->v[0]); }
+        else { o = put48(o, DE_ID_D_C, (uint64_t)c->v[2]); o = put48(o, DE_ID_D_B_C, (uint64_t)c->v[1]); o = put48(o, DE_ID_D_A_B, (uint64_t)c->v[0]); }
+        return put48(o, DE_ID_ACC, 0);
+    default: return o;
     }
-    default: break;
+}
+
+/* The words of line l followed by its Refresh into *buf (grown as needed, *cap bytes);
+ * returns the words written, 0 if out of memory. */
+static size_t line_words(const yp_cmdlist *l, uint8_t **buf, size_t *cap)
+{
+    size_t need = ((size_t)l->n * YP_MAX_CMD_SLOTS + 1) * YP_WORD_BYTES;
+    if (need > *cap) {
+        uint8_t *p = realloc(*buf, need);
+        if (!p) return 0;
+        *buf = p; *cap = need;
     }
+    uint8_t *o = *buf;
+    for (int i = 0; i < l->n; i++) o = put_cmd(o, &l->c[i]);
+    o = put48(o, DE_ID_REFRESH, 0);
+    return (size_t)(o - *buf) / YP_WORD_BYTES;
+}
+
+/* ---- the pixels of a line: sw/fmodel ----------------------------------- */
+hsr_status yp_simulate_line(const yp_cmdlist *l, int width, uint16_t *pix)
+{
+    if (!pix || width < 1) return HSR_EINVAL;
+    hsr_status st = HSR_EINVAL;
+    uint8_t *w = NULL;
+    size_t cap = 0, n = 0, lines = 0;
+    if (l && width <= FM_MAX_WIDTH) {
+        st = HSR_ENOMEM;
+        if ((n = line_words(l, &w, &cap)) > 0) {
+            /* one row: the list's words and its Refresh; a Refresh inside the list would
+             * make a second line (FM_ELIMIT): a list is one line */
+            fm_status fs = fm_render(w, n, width, YP_CARRY_BUG, pix, 0, 1, NULL, 1, &lines, NULL, NULL);
+            st = fs == FM_OK && lines == 1 ? HSR_OK : fs == FM_ENOMEM ? HSR_ENOMEM : HSR_EINVAL;
+        }
+    }
+    free(w);
+    /* what the old model did when out of memory: a black line, never stale pixels */
+    if (st != HSR_OK) memset(pix, 0, sizeof(uint16_t) * (size_t)width);
+    return st;
 }
 
 hsr_status yp_write_de48(const yp_frame *fr, int colour, const char *path)
@@ -173,16 +168,19 @@ hsr_status yp_write_de48(const yp_frame *fr, int colour, const char *path)
     FILE *f = fopen(path, "wb");
     if (!f) return HSR_EIO;
     static const unsigned char hdr[8] = {'D', 'E', '4', '8', 0, 1, 0, 0};
-    fwrite(hdr, 1, 8, f);
-    const yp_cmd refresh = {YP_REFRESH, 0, 0, 0, {0, 0, 0}};
-    flockfile(f);
-    for (int y = 0; y < fr->height; y++) {
-        const yp_cmdlist *l = &fr->line[colour * fr->height + y];
-        for (int i = 0; i < l->n; i++) put_cmd(f, &l->c[i]);
-        put_cmd(f, &refresh);
+    hsr_status st = fwrite(hdr, 1, sizeof hdr, f) == sizeof hdr ? HSR_OK : HSR_EIO;
+    /* a line at a time: one fwrite per line, not a lock per word (~5 ms a frame for
+     * the viewer when it was one per word) */
+    uint8_t *buf = NULL;
+    size_t cap = 0;
+    for (int y = 0; y < fr->height && st == HSR_OK; y++) {
+        size_t n = line_words(&fr->line[colour * fr->height + y], &buf, &cap);
+        if (!n) st = HSR_ENOMEM;
+        else if (fwrite(buf, YP_WORD_BYTES, n, f) != n) st = HSR_EIO;
     }
-    funlockfile(f);
-    return fclose(f) == 0 ? HSR_OK : HSR_EIO;
+    free(buf);
+    if (fclose(f) != 0 && st == HSR_OK) st = HSR_EIO;
+    return st;
 }
 
 static void fixed(char *buf, size_t n, int64_t v)

@@ -375,7 +375,7 @@ static int wraps(scan *s, const yp_cmdlist *l, int y, int c)
 {
     uint16_t *pix = malloc(sizeof(uint16_t) * (size_t)s->W);
     if (!pix) return 0;
-    yp_simulate_line(l, s->W, pix);
+    if (yp_simulate_line(l, s->W, pix) != HSR_OK) { free(pix); return 0; }   /* as without pix */
     const double *id = &s->fr->ideal[((size_t)c * s->H + y) * s->W];
     int bad = 0;
     for (int x = 0; x < s->W && !bad; x++) bad = fabs(pix[x] - id[x]) > 2048;

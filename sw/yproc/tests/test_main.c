@@ -5,6 +5,7 @@
 void suite_yp_tex_lod(void);   /* test_yp_tex_lod.c */
 void suite_yp_coh(void);       /* test_yp_coh.c */
 void suite_yp_tess(void);      /* test_yp_tess.c */
+void suite_yp_fmodel(void);    /* test_yp_fmodel.c */
 
 int main(int argc, char **argv)
 {
@@ -15,5 +16,6 @@ int main(int argc, char **argv)
     suite_yp_tex_lod();
     suite_yp_coh();
     suite_yp_tess();
+    suite_yp_fmodel();
     return t_report();
 }

@@ -130,7 +130,11 @@ static int write_expect(const yp_frame *fr, const char *dir)
     uint16_t *pix = malloc(sizeof(uint16_t) * 3 * (size_t)W * (size_t)H);
     if (!pix) return 1;
     for (int c = 0; c < 3; c++)
-        for (int y = 0; y < H; y++) yp_simulate_line(&fr->line[c * H + y], W, &pix[((size_t)c * H + y) * W]);
+        for (int y = 0; y < H; y++)
+            if (yp_simulate_line(&fr->line[c * H + y], W, &pix[((size_t)c * H + y) * W]) != HSR_OK) {
+                free(pix);
+                return 1;
+            }
     snprintf(p, sizeof p, "%s/expect.ppm", dir);
     FILE *f = fopen(p, "wb");
     if (!f) { free(pix); return 1; }
@@ -373,7 +377,7 @@ static double frame_max_err(const yp_frame *fr)
     if (!pix) return -1;
     for (int c = 0; c < 3; c++)
         for (int y = 0; y < H; y++) {
-            yp_simulate_line(&fr->line[c * H + y], W, pix);
+            if (yp_simulate_line(&fr->line[c * H + y], W, pix) != HSR_OK) { free(pix); return -1; }
             const double *id = &fr->ideal[((size_t)c * H + y) * W];
             for (int x = 0; x < W; x++) if (fabs(pix[x] - id[x]) > mx) mx = fabs(pix[x] - id[x]);
         }
