@@ -26,7 +26,6 @@ import json
 import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
 from pathlib import Path
@@ -34,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import REPO as ROOT
-from . import record, render as doc
+from . import baseline, record, render as doc
 from .hsr import kv, run, teapot_scene_dir
 
 HSR = ROOT / "sw" / "hsr"
@@ -55,14 +54,7 @@ def log(msg: str) -> None:
 
 def build_baseline(rev: str, tmp: Path) -> tuple[Path, Path]:
     """(hsr_bench, yproc) of revision rev, from `git archive` in tmp."""
-    src = tmp / "base"
-    src.mkdir()
-    arch = tmp / "base.tar"
-    with open(arch, "wb") as f:
-        subprocess.run(["git", "-C", str(ROOT), "archive", rev, "sw/hsr", "sw/yproc", "sw/include",
-                        "sw/lib.mk"], stdout=f, check=True)
-    with tarfile.open(arch) as t:
-        t.extractall(src)
+    src = baseline.extract(rev, tmp / "base")
     subprocess.run(["make", "-s", "-C", str(src / "sw" / "yproc"), "build/yproc"], check=True)
     bench = src / "hsr_bench_baseline"
     subprocess.run(["cc", "-std=c11", "-O2", "-DHSR_BENCH_BASELINE", f"-I{src / 'sw/hsr/include'}",

@@ -17,7 +17,7 @@
 about 1K to 100K triangles at 640x480: teapots made by sw/scenes/teapot/make_teapot.py
 (-n 4, 7, 13, 22, 40: 992 .. 102,080 triangles, same camera) and the Stanford bunny
 (sw/scenes/meshes/bunny.scene, 69,451).  With --baseline-rev, the yproc of that revision
-(sources taken with `git archive`, built in a temporary directory) runs alternately with
+(sources taken with `git archive`, bench.baseline, built in a temporary directory) runs alternately with
 this tree's in the same session; every figure is the min and median of --repeat runs,
 wall clock and the child's CPU time (user + sys), with the load average before and after.
 Both record out/bench/NAME.json (bench.record); --write keeps it in docs/bench and renders
@@ -30,13 +30,12 @@ import os
 import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
 from pathlib import Path
 
 from .. import REPO as ROOT
-from . import record, render as doc
+from . import baseline, record, render as doc
 
 YPROC = ROOT / "sw" / "yproc" / "build" / "yproc"
 SECTION = "## Y-processor: commands per line and host time"
@@ -115,17 +114,7 @@ def plot(rows: list, path: Path) -> None:
 
 def build_rev(rev: str, tmp: Path) -> Path:
     """yproc of git revision rev, built from `git archive` in tmp (the repository is not touched)."""
-    src = tmp / "base"
-    src.mkdir()
-    arch = tmp / "base.tar"
-    with open(arch, "wb") as f:
-        # sw/include and sw/yproc exist only from issue 17 on
-        paths = [p for p in ("sw/hsr", "sw/include", "sw/yproc")
-                 if subprocess.run(["git", "-C", str(ROOT), "cat-file", "-e", f"{rev}:{p}"],
-                                   capture_output=True).returncode == 0]
-        subprocess.run(["git", "-C", str(ROOT), "archive", rev, *paths], stdout=f, check=True)
-    with tarfile.open(arch) as t:
-        t.extractall(src)
+    src = baseline.extract(rev, tmp / "base")
     # before issue 17 the y-processor was built inside sw/hsr
     home = src / "sw" / ("yproc" if (src / "sw" / "yproc" / "Makefile").exists() else "hsr")
     subprocess.run(["make", "-s", "-C", str(home), "build/yproc"], check=True)
