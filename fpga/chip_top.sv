@@ -32,9 +32,17 @@ module chip_top #(
   output logic obs_bit_o,
   output logic fold_o         // XOR of every chip output bit, registered
 );
-  localparam int unsigned InW  = 12 + 36 + 1 + 12;             // id, data, pix_valid, pix
-  localparam int unsigned IdW  = de_pkg::IdW;                  // = 12, sh_q[11:0]
-  localparam int unsigned OutW = 12 + 36 + 1 + 12 + NumPe + 1; // + bypass, collision
+  // The input shift register holds one link_t without its collision bit, LSB first:
+  // id, data, pix_valid, pix (de_pkg's widths).
+  localparam int unsigned IdW     = de_pkg::IdW;
+  localparam int unsigned DataW   = de_pkg::DataW;
+  localparam int unsigned BlkW    = de_pkg::BlkW;
+  localparam int unsigned PixW    = de_pkg::PixW;
+  localparam int unsigned DataLsb = IdW;                       // sh_q[DataLsb +: DataW]
+  localparam int unsigned PixVLsb = DataLsb + DataW;           // sh_q[PixVLsb]
+  localparam int unsigned PixLsb  = PixVLsb + 1;               // sh_q[PixLsb +: PixW]
+  localparam int unsigned InW     = PixLsb + PixW;
+  localparam int unsigned OutW    = InW + NumPe + 1;           // + bypass, collision
   localparam int unsigned Grp  = 4;                            // XOR inputs per LUT
   localparam int unsigned NGrp = (OutW + Grp - 1) / Grp;
 
@@ -64,9 +72,9 @@ module chip_top #(
     obs_load_q  <= obs_load_i;
     obs_shift_q <= obs_shift_i;
     obs_bit_q   <= obs_bit_i;
-    // de_chip's input block 1 (sh_q[35:24]) is zero next cycle: what the upstream chip's
-    // boundary register provides in an array.
-    blk1z_q     <= (sh_q[34:23] == '0);
+    // de_chip's input block 1 (sh_q[DataLsb+BlkW +: BlkW]) is zero next cycle, when the
+    // register has shifted by one: what the upstream chip's boundary register provides.
+    blk1z_q     <= (sh_q[DataLsb+BlkW-1 +: BlkW] == '0);
   end
   logic [IdW-1:0]   idsel;
   if (Compact == 1) begin : g_in_small
@@ -91,7 +99,8 @@ module chip_top #(
     .clk_i,
     .rst_i      (rst_q),
     // id, data, pix_valid, pix from the shift register; de_chip does not use link_i.coll
-    .link_i     ({sh_q[11:0], sh_q[47:12], sh_q[48], sh_q[60:49], 1'b0}),
+    .link_i     ({sh_q[IdW-1:0], sh_q[DataLsb +: DataW], sh_q[PixVLsb], sh_q[PixLsb +: PixW],
+                  1'b0}),
     .link_o,
     .blk1z_i    (blk1z_q),
     .blk1z_o    (),
