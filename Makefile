@@ -196,6 +196,8 @@ postsynth: $(SETUP)
 
 clean:
 	rm -rf $(OUT) build sim/out sim/build sw/hsr/build sw/yproc/build sw/fmodel/build fpga/build
+	rm -rf fpga/ulx3s/build fpga/ctrl/out tb/formal/build
 	find tb -name 'sim_build*' -prune -exec rm -rf {} +
+	find tb -name '*.result.xml' -delete
 	rm -f tb/de_array/coverage_*.txt tb/de_array/seed_*.txt
 	git worktree prune 2>/dev/null || true
