@@ -54,7 +54,9 @@ help:
 	@echo "make fuzz-hsr    coverage-guided libFuzzer run of the sw/hsr fuzz targets (clang)"
 	@echo "make setup       create .venv from scripts/requirements.txt"
 	@echo "make clean       remove every build product: out/, build/, sim/build, sim/out, sw/hsr/build,"
-	@echo "                 sw/yproc/build, fpga/build, tb/*/sim_build* (keeps .venv and the ccache)"
+	@echo "                 sw/yproc/build, sw/fmodel/build, fpga/build, fpga/ulx3s/build (the board's"
+	@echo "                 bitstream: 30+ min to redo), fpga/ctrl/out, tb/formal/build, tb/*/sim_build*,"
+	@echo "                 the cocotb result XML files (keeps .venv, the ccache and the committed reports)"
 
 setup: $(SETUP)
 $(SETUP): scripts/setup.sh scripts/requirements.txt sw/pyproject.toml
