@@ -17,9 +17,11 @@ def _rev_without(path: str) -> str:
     first = subprocess.run(["git", "-C", str(REPO), "log", "--diff-filter=A", "--format=%H",
                             "--reverse", "--", path], capture_output=True, text=True,
                            check=True).stdout.split()
-    if not first:
-        pytest.skip(f"no history for {path} (shallow clone)")
-    return first[0] + "^"
+    rev = first[0] + "^" if first else ""
+    if not first or subprocess.run(["git", "-C", str(REPO), "cat-file", "-e", rev],
+                                   capture_output=True).returncode != 0:
+        pytest.skip(f"the commit before {path} was added is not in this clone (shallow)")
+    return rev
 
 
 def test_head_has_every_c_source():
