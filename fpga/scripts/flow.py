@@ -27,13 +27,13 @@ clock (docs/fpga.md, "Timing over seeds"):
 Only the chip's committed configuration (seeds 1-5, --freq 200, the default timing weight,
 no --pnr-arg) writes fpga/reports/seeds_chip.*; any other chip run is a trial: its seeds
 and report go to fpga/build/chip_ecp5/pe9/trial_<options>/, so a sweep of options never
-overwrites the committed figures (docs/fpga.md section 6.3, sixth look).
+overwrites the committed figures (docs/fpga-timing-log.md section 6, sixth look).
 
 `pe` is the quick loop for the PE's own timing: chip_top with --num-pe PEs (default 2,
 so that one PE-to-PE path is in it) synthesised into fpga/build/pe_loop/pe<N>, placed and
 routed on the LFE5U-85F-6 with each seed; it prints fmax and nextpnr's worst paths step by
 step (cell, port, delay, RTL line), which is how the stage-0 path of de_pe.sv was
-measured (docs/fpga.md, section 6.3). Nothing is written to fpga/reports.
+measured (docs/fpga-timing-log.md, section 2). Nothing is written to fpga/reports.
 
 `frames` is the quick loop for the board's SDRAM clock (docs/sdram.md, section 5):
 de_sdram_frames alone (controller, arbiter, info FIFO, return path, fetchers, all FIFOs,
@@ -87,8 +87,8 @@ ICE40 = [{"args": ["--up5k", "--package", "sg48"], "name": "iCE40UP5K SG48", "lc
 
 # nextpnr-ecp5's placer timing weight for the chip's runs (chip --family ecp5, seeds
 # --design chip, pe; --timing-weight overrides it): 10 is nextpnr's own default, which
-# then adds no option. The board flow (fpga/ulx3s) does not read this. docs/fpga.md
-# section 6.3, fifth pass: the levers measured over seeds.
+# then adds no option. The board flow (fpga/ulx3s) does not read this. The levers
+# measured over seeds: docs/fpga.md section 6.3; docs/fpga-timing-log.md sections 5-7.
 CHIP_TIMING_WEIGHT = 10
 
 

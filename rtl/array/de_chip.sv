@@ -388,7 +388,7 @@ module de_chip_bound
 
   if (IdCopy == 1) begin : g_idsel
     // id_q and its copy as kept per-bit processes: otherwise yosys' opt_merge folds the
-    // copy into id_q (docs/fpga.md section 6.3, third and fourth pass).
+    // copy into id_q (docs/fpga-timing-log.md section 4, third and fourth pass).
     logic [IdW-1:0] idsel_q;
     for (genvar k = 0; k < IdW; k++) begin : g_bit
       (* keep *) always_ff @(posedge clk_i) begin

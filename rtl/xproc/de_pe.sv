@@ -28,7 +28,7 @@ module de_pe
   parameter int unsigned RstW = 1,
   // Timing only: 1 = the stage-0 operand selects read idsel_i, a second copy of the
   // previous PE's identifier register, so that they do not wait on id_i's fan-out to the
-  // whole decode (docs/fpga.md section 6.3, fourth pass); 0 = they read id_i.
+  // whole decode (docs/fpga-timing-log.md section 4, fourth pass); 0 = they read id_i.
   parameter int unsigned IdCopy = 0,
   // Timing only: 1 = pixv_c_o is a register of its own (a copy of the pixel-valid register
   // for the chip's collision flag and valid chain); 0 = pixv_c_o is pix_valid_o.
@@ -521,7 +521,7 @@ module de_pe
   // act1_q is still reset).
   // Reset groups (timing only): each group reads its own copy of the reset and of the
   // bypass bit (RstW copies, all equal), so that a copy fans out to a group's set/reset
-  // logic, not to the ~300 flip-flops of the PE (docs/fpga.md section 6.3, third pass).
+  // logic, not to the ~300 flip-flops of the PE (docs/fpga-timing-log.md section 4).
   localparam int unsigned RstBus = 0, RstAb = 1, RstCd = 2, RstCtl = 3;
   logic rst_bus, hold_ab, hold_cd, hold_ctl;
   assign rst_bus  = rst_i[RstBus % RstW];
@@ -629,7 +629,7 @@ module de_pe
   end
 
   // The second copy of id_q for the next PE's operand selects: a kept process of its own,
-  // or yosys' opt_merge folds it into id_q (docs/fpga.md section 6.3, third pass).
+  // or yosys' opt_merge folds it into id_q (docs/fpga-timing-log.md section 4).
   // One kept process per bit, for id_q as for its copy: a keep on a vector's process, or
   // on one of the two copies only, still lets opt_merge fold them into one. Without the
   // copy (IdCopy = 0) id_q is a plain register (synthesis may then drop unread bits).

@@ -1,6 +1,6 @@
 """fpga/scripts/flow.py: a chip seed run with other options than the committed ones is a
-trial and never overwrites fpga/reports/seeds_chip.* (docs/fpga.md section 6.3, sixth
-look). Only the option handling is tested here; no tool runs."""
+trial and never overwrites fpga/reports/seeds_chip.* (docs/fpga-timing-log.md section 6,
+sixth look). Only the option handling is tested here; no tool runs."""
 from __future__ import annotations
 
 import argparse
