@@ -12,10 +12,15 @@
 
 /* One command of docs/isa.md.  v[] are signed 12.24 values (pixel units
  * times 2^24): Eval (order 0..2): I, dI, ddI; Set*: v[0]; Eval0: v[0] is
- * the 12-bit intensity; Acc_mode: v[0] = 1 on / 0 off. */
+ * the 12-bit intensity; Acc_mode: v[0] = 1 on / 0 off.  term is the host's, not the
+ * instruction's: which term of the line the command was fitted for (a pattern's colour
+ * function and texture, or its specular term of one light; yp_scan, 1..65535, unique
+ * within the line; 0: none), so that coherent fitting (yp_options.prev) takes up a term's
+ * own commands of the previous frame and no other's; it is not written to a stream and
+ * yp_cmdlist_equal does not compare it (docs/yproc.md section 11.1). */
 typedef enum yp_op { YP_EVAL = 1, YP_EVAL0, YP_SETI, YP_SETDI, YP_SETDDI, YP_DIS,
                      YP_ACCMODE, YP_REFRESH } yp_op;
-typedef struct yp_cmd { uint8_t op, order; uint16_t x, dx; int64_t v[3]; } yp_cmd;
+typedef struct yp_cmd { uint8_t op, order; uint16_t x, dx; int64_t v[3]; uint16_t term; } yp_cmd;
 typedef struct yp_cmdlist { yp_cmd *c; int n, cap, slots; } yp_cmdlist;
 int yp_cmd_slots(const yp_cmd *c);                 /* instructions (Table 7.2) */
 hsr_status yp_cmdlist_push(yp_cmdlist *l, yp_cmd c);

@@ -206,10 +206,10 @@ int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n,
         if (use[x] && !ok_at((double)val[x] / S, f[x], tolv ? tolv[x] : tol, clamp)) bad = 1;
     hsr_status st = HSR_OK;
     for (int i = 0; i < nk && st == HSR_OK; i++) {
-        yp_cmd s = {(uint8_t)(YP_SETI + order), 0, (uint16_t)(x0 + kp[i]), 1, {kc[i], 0, 0}};
+        yp_cmd s = {(uint8_t)(YP_SETI + order), 0, (uint16_t)(x0 + kp[i]), 1, {kc[i], 0, 0}, 0};
         st = yp_cmdlist_push(out, s);
     }
-    yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {v0[0], v0[1], v0[2]}};
+    yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {v0[0], v0[1], v0[2]}, 0};
     if (st == HSR_OK) st = yp_cmdlist_push(out, ev);
     if (!small) { free(kp); free(kc); free(val); free(tab); }
     return bad || st != HSR_OK ? -1 : nk;
@@ -247,14 +247,16 @@ static void eval_sets(int order, const int64_t *v0, int n, const fset *s, int ns
 }
 
 /* the Sets of prev's Eval at index i that act on it: the run of Sets of its registers
- * on its columns right before it (yp_fit and yp_fit_coherent put them there) */
+ * on its columns (and of its term) right before it (yp_fit and yp_fit_coherent put them
+ * there) */
 static int gather_sets(const yp_cmdlist *prev, int i0, int i, int n, fset *s)
 {
     const yp_cmd *e = &prev->c[i];
     int ns = 0;
     for (int j = i - 1; j >= i0; j--) {
         const yp_cmd *q = &prev->c[j];
-        if (q->op < YP_SETI || q->op > YP_SETI + e->order || q->dx != 1 || q->x < e->x || q->x >= e->x + e->dx) break;
+        if (q->op < YP_SETI || q->op > YP_SETI + e->order || q->dx != 1 || q->x < e->x || q->x >= e->x + e->dx
+            || q->term != e->term) break;
         if (q->x - e->x < n) s[ns++] = (fset){q->x - e->x, q->op - YP_SETI, q->v[0]};
     }
     qsort(s, (size_t)ns, sizeof *s, fset_cmp);
@@ -287,21 +289,33 @@ static hsr_status push_fset(fset **s, int *ns, int *cap, fset v)
 
 #define YP_COH_LMIN 24    /* pixels the old spline must hold after a resync [choice] */
 
+/* src's commands from index from on, after dst's (plain: the fit without prev) */
+static hsr_status push_from(yp_cmdlist *dst, const yp_cmdlist *src, int from)
+{
+    hsr_status st = HSR_OK;
+    for (int i = from; dst && i < src->n && st == HSR_OK; i++) st = yp_cmdlist_push(dst, src->c[i]);
+    return st;
+}
+
 int yp_fit_coherent(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order,
-                    double tol, int clamp, double hyst, const yp_cmdlist *prev, int i0, int i1, yp_cmdlist *out,
-                    int *kept)
+                    double tol, int clamp, double hyst, const yp_cmdlist *prev, int i0, int i1, unsigned term,
+                    yp_cmdlist *out, yp_cmdlist *plain_out, int *kept)
 {
     if (kept) *kept = 0;
     if (n <= 0) return -1;
+    const int out0 = out->n;
     /* what is (re)fitted is fitted at hyst * tol; an old spline is kept while within tol */
     double *th = malloc(sizeof(double) * (size_t)n);
-    if (!th) return yp_fit(f, use, tolv, n, x0, order, tol, clamp, out);
+    if (!th) {
+        int r = yp_fit(f, use, tolv, n, x0, order, tol, clamp, out);
+        return push_from(plain_out, out, out0) == HSR_OK ? r : -1;
+    }
     for (int x = 0; x < n; x++) th[x] = (tolv ? tolv[x] : tol) * hyst;
     const double tf = tol * hyst;
     if (!prev || order < 1 || order > 2 || i0 < 0 || i1 > prev->n) {
         int r = yp_fit(f, use, th, n, x0, order, tf, clamp, out);
         free(th);
-        return r;
+        return push_from(plain_out, out, out0) == HSR_OK ? r : -1;
     }
     const double S = YP_ONE, T = tf * S * (1 - 1e-9);
     int oldcap = 0;
@@ -314,10 +328,12 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
     int best = -1, bestfail = n + 1, nos = 0, nns = 0, nscap = 0, rc = -1;
     hsr_status st = HSR_OK;
     if (!os || !val || !ost || !nextfail || !tab) goto fallback;
-    /* the candidate of the previous line that fails at the fewest pixels */
+    /* the candidate of the previous line that fails at the fewest pixels: an Eval of the
+     * same term (the same pattern: the column alone does not say whose it is, two patterns
+     * sharing the pixel x0 both start there), order and column */
     for (int i = i0; i < i1; i++) {
         const yp_cmd *e = &prev->c[i];
-        if (e->op != YP_EVAL || e->order != order || e->x != x0) continue;
+        if (e->op != YP_EVAL || e->order != order || e->x != x0 || e->term != term) continue;
         int no = gather_sets(prev, i0, i, n, os), fails = 0;
         eval_sets(order, e->v, n, os, no, val, NULL);
         for (int x = 0; x < n; x++) fails += use[x] && !ok_at((double)val[x] / S, f[x], tolv ? tolv[x] : tol, clamp);
@@ -397,16 +413,18 @@ int yp_fit_coherent(const double *f, const unsigned char *use, const double *tol
     if (slots > plain.slots + (plain.slots / 4 > 8 ? plain.slots / 4 : 8)) goto fallback;
     for (int j = 0; j < nns && st == HSR_OK; j++) {
         static const uint8_t op[3] = {YP_SETI, YP_SETDI, YP_SETDDI};
-        yp_cmd s = {op[ns_[j].reg], 0, (uint16_t)(x0 + ns_[j].pos), 1, {ns_[j].v, 0, 0}};
+        yp_cmd s = {op[ns_[j].reg], 0, (uint16_t)(x0 + ns_[j].pos), 1, {ns_[j].v, 0, 0}, 0};
         st = yp_cmdlist_push(out, s);
     }
-    yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {hv[0], hv[1], hv[2]}};
+    yp_cmd ev = {YP_EVAL, (uint8_t)order, (uint16_t)x0, (uint16_t)n, {hv[0], hv[1], hv[2]}, 0};
     if (st == HSR_OK) st = yp_cmdlist_push(out, ev);
+    if (st == HSR_OK) st = push_from(plain_out, &plain, 0);
     rc = st == HSR_OK ? nns : -1;
     if (kept) *kept = !fresh || nold > 0;
     goto done;
 fallback:
     rc = yp_fit(f, use, th, n, x0, order, tf, clamp, out);
+    if (push_from(plain_out, out, out0) != HSR_OK) rc = -1;
 done:
     free(th); free(os); free(ns_); free(val); free(ost); free(nextfail); free(tab); yp_cmdlist_free(&plain);
     return rc;

@@ -76,18 +76,20 @@ void yp_cover_ring(const double *xy, int n, double *acc, int nx, int ny);
 int yp_fit(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order,
            double tol, int clamp, yp_cmdlist *out);   /* tolv: per-pixel tolerance or NULL */
 /* yp_fit, temporally coherent (docs/yproc.md section 11): prev's commands i0..i1-1 (the
- * previous frame's line) are searched for an Eval of the same order at x0; where its
- * spline (with the Sets before it) still meets the tolerance against f its Sets are
- * kept word for word, and only the failing pixels are refitted, rejoining the old
- * spline with SetI / SetdI / Set of the top difference.  Falls back to yp_fit (no
- * candidate, or a result more than a quarter above yp_fit's slots).  hyst (0 < hyst
- * <= 1): what is fitted anew is fitted at hyst * tol (and hyst * tolv), so that it can
- * stay while the target drifts by up to (1 - hyst) * tol; prev NULL: yp_fit at hyst *
- * tol.  *kept: 1 if the old spline was used.  Same error bound as yp_fit at tol (the
- * result is re-checked). */
+ * previous frame's line) are searched for an Eval of the same order at x0 and of the same
+ * term (yp_cmd.term: the pattern's, 0 if untagged); where its spline (with the Sets
+ * before it) still meets the tolerance against f its Sets are kept word for word, and
+ * only the failing pixels are refitted, rejoining the old spline with SetI / SetdI / Set
+ * of the top difference.  Falls back to yp_fit (no candidate, or a result more than a
+ * quarter above yp_fit's slots).  hyst (0 < hyst <= 1): what is fitted anew is fitted at
+ * hyst * tol (and hyst * tolv), so that it can stay while the target drifts by up to
+ * (1 - hyst) * tol; prev NULL: yp_fit at hyst * tol.  *kept: 1 if the old spline was
+ * used.  plain_out (or NULL) gets the Sets and the Eval of the fit without prev (yp_fit
+ * at hyst * tol, computed anyway for the quarter rule).  Same error bound as yp_fit at
+ * tol (the result is re-checked). */
 int yp_fit_coherent(const double *f, const unsigned char *use, const double *tolv, int n, int x0, int order,
-                    double tol, int clamp, double hyst, const yp_cmdlist *prev, int i0, int i1, yp_cmdlist *out,
-                    int *kept);
+                    double tol, int clamp, double hyst, const yp_cmdlist *prev, int i0, int i1, unsigned term,
+                    yp_cmdlist *out, yp_cmdlist *plain_out, int *kept);
 /* forward differencing of an order-p Eval with knots (value per column) */
 void yp_eval_values(int order, const int64_t *v0, int n, const int *knot_pos,
                     const int64_t *knot_c, int nk, int64_t *val);

@@ -38,9 +38,95 @@ typedef struct entry {
     int npart;
     yp_cmdlist lv[4], spec;    /* lv[1..3]: Dis + Sets + Eval over the covered pixels */
     yp_cmdlist tex;            /* texture term (yp_tex.c), emitted after lv[lev]; in cost[] */
+    /* coherent fitting with a previous frame: the same terms fitted without it (what lv
+     * and spec are without one), their costs; the level of every pattern is chosen on
+     * these, so that it does not depend on the history (docs/yproc.md section 11.1) */
+    yp_cmdlist plv[4], pspec;
+    int pcost[4], pspec_cost;
 } entry;
 
-typedef struct line_entries { entry **e; int n, cap; } line_entries;
+/* where a term's commands are in the previous frame's line: [lo, hi) */
+typedef struct tspan { uint16_t term; int lo, hi; } tspan;
+
+/* a line's entries (one per pattern, in the order they are emitted); in colour 0's the
+ * terms (yp_cmd.term) its patterns took; with a previous frame, where its line's terms are
+ * (open addressing, built at the first entry) */
+typedef struct line_entries {
+    entry **e; int n, cap;
+    uint16_t *term; int nterm, tcap;
+    tspan *ps; int pscap, pbuilt;
+} line_entries;
+
+/* the spans of the previous line's terms: a term's commands are contiguous (its colour
+ * function and texture before Acc_mode, a specular term after it), so a search for its
+ * commands looks at them only, not at the whole line for every pattern.  0: no memory */
+static int prev_spans(line_entries *L, const yp_cmdlist *pl)
+{
+    L->pbuilt = 1;
+    int cap = 16;
+    while (cap < 2 * pl->n) cap *= 2;
+    if (!(L->ps = calloc((size_t)cap, sizeof *L->ps))) return 0;
+    L->pscap = cap;
+    const unsigned m = (unsigned)cap - 1;
+    for (int i = 0; i < pl->n; i++) {
+        unsigned t = pl->c[i].term, k = t & m;
+        if (!t) continue;
+        while (L->ps[k].term && L->ps[k].term != t) k = (k + 1) & m;
+        if (!L->ps[k].term) L->ps[k] = (tspan){(uint16_t)t, i, i + 1};
+        else L->ps[k].hi = i + 1;
+    }
+    return 1;
+}
+
+static void prev_span(const line_entries *L, unsigned t, int *lo, int *hi)
+{
+    *lo = *hi = 0;
+    if (!L->ps || !t) return;
+    const unsigned m = (unsigned)L->pscap - 1;
+    for (unsigned k = t & m; L->ps[k].term; k = (k + 1) & m)
+        if (L->ps[k].term == t) { *lo = L->ps[k].lo; *hi = L->ps[k].hi; return; }
+}
+
+/* A term of a pattern on a line (yp_cmd.term; salt 0: its colour function and texture,
+ * 1 + l: its specular term of light l): a hash of the layer stack and the salt, so that
+ * it names the same term in the next frame, made unique within the line (the next free
+ * value after a collision).  Coherent fitting takes up only a term's own commands of the
+ * previous frame: by column alone it took another pattern's when two start at one pixel
+ * (both cover it partly), or another light's specular term, and a line re-fitted against
+ * itself was not itself.  A line with more than 32767 terms gets the hash as it is (not
+ * unique; such a line is far over any capacity).  0: no memory. */
+static unsigned line_term(line_entries *L, const int *par, int nvis, int salt)
+{
+    uint32_t h = 2166136261u;   /* FNV-1a over the stack and the salt */
+    for (int j = 0; j <= nvis; j++) {
+        uint32_t w = j < nvis ? (uint32_t)par[j] : (uint32_t)salt;
+        for (int b = 0; b < 4; b++) { h ^= (w >> (8 * b)) & 255u; h *= 16777619u; }
+    }
+    unsigned t = (h ^ (h >> 16)) & 0xffffu;
+    if (t == 0) t = 1;
+    if (L->nterm >= 32767) return t;
+    if (2 * (L->nterm + 1) > L->tcap) {   /* open addressing, at most half full */
+        int nc = L->tcap ? 2 * L->tcap : 64;
+        uint16_t *p = calloc((size_t)nc, sizeof *p);
+        if (!p) return 0;
+        for (int i = 0; i < L->tcap; i++)
+            if (L->term[i]) { unsigned k = L->term[i] & (unsigned)(nc - 1); while (p[k]) k = (k + 1) & (unsigned)(nc - 1); p[k] = L->term[i]; }
+        free(L->term); L->term = p; L->tcap = nc;
+    }
+    const unsigned m = (unsigned)L->tcap - 1;
+    for (;;) {
+        if (t == 0) t = 1;
+        unsigned k = t & m;
+        while (L->term[k] && L->term[k] != t) k = (k + 1) & m;
+        if (!L->term[k]) { L->term[k] = (uint16_t)t; L->nterm++; return t; }
+        t = (t + 1) & 0xffffu;      /* taken by another pattern of the line */
+    }
+}
+
+static void set_term(yp_cmdlist *l, unsigned term)
+{
+    for (int i = 0; i < l->n; i++) l->c[i].term = (uint16_t)term;
+}
 
 typedef struct key { int slot; const int *par; int nvis; } key;
 
@@ -104,6 +190,7 @@ typedef struct scan {
     double *covsum;            /* [y1 - y0][W]: coverage of all patterns */
     arena ar;                  /* entries and their lists */
     yp_cmdlist wl[4], wspec, wtex;   /* scratch lists of one entry */
+    yp_cmdlist wpl, wpspec, wfit;    /* and its terms without the previous frame */
 } scan;
 
 /* the options of line y: its level of detail (yp_lod.c) or the frame's */
@@ -114,6 +201,8 @@ static void line_opts(const scan *s, int y, int *maxlev, int *aa, double *tol, i
     *aa = s->o->aa; *tol = s->o->tol; *tex = 1;
 }
 
+static hsr_status append(yp_cmdlist *dst, const yp_cmdlist *src);
+
 /* Dis over the runs of [a, b) where in[x - off] == 0 */
 static hsr_status push_dis(yp_cmdlist *l, const unsigned char *in, int a, int b, int off)
 {
@@ -121,7 +210,7 @@ static hsr_status push_dis(yp_cmdlist *l, const unsigned char *in, int a, int b,
         if (in[x - off]) { x++; continue; }
         int g = x;
         while (x < b && !in[x - off]) x++;
-        yp_cmd d = {YP_DIS, 0, (uint16_t)g, (uint16_t)(x - g), {0, 0, 0}};
+        yp_cmd d = {YP_DIS, 0, (uint16_t)g, (uint16_t)(x - g), {0, 0, 0}, 0};
         hsr_status st = yp_cmdlist_push(l, d);
         if (st != HSR_OK) return st;
     }
@@ -180,6 +269,11 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         s->covsum[(size_t)(y - s->y0) * s->W + x] += cov[x - x0];
     }
     line_entries *le = &s->le[3 * (y - s->y0)];
+    const unsigned term = line_term(&le[0], par, nvis, 0);
+    unsigned sterm[HSR_MAX_LIGHTS];
+    for (int l = 0; l < nl; l++) sterm[l] = line_term(&le[0], par, nvis, 1 + l);
+    if (!term) return HSR_ENOMEM;
+    for (int l = 0; l < nl; l++) if (!sterm[l]) return HSR_ENOMEM;
     int cf = -1, cl = -1;
     for (int x = x0; x < x1; x++) if (cov[x - x0] > 0) { if (cf < 0) cf = x; cl = x; }
     const int a = cf, n = cl + 1 - cf;
@@ -198,7 +292,7 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         }
         L->e[L->n++] = e;
         for (int i = 0; i < 4; i++) s->wl[i].n = s->wl[i].slots = 0;
-        s->wspec.n = s->wspec.slots = s->wtex.n = s->wtex.slots = 0;
+        s->wspec.n = s->wspec.slots = s->wtex.n = s->wtex.slots = s->wpspec.n = s->wpspec.slots = 0;
         e->area = area; e->npart = npart;
         e->maxlev = lmax;
         /* separate specular terms (level 3): lights whose highlight on the
@@ -213,11 +307,12 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
         }
         double *f = s->tmp;
         hsr_status st = HSR_OK;
-        /* coherent fitting: the previous frame's line, its terms before Acc_mode (the
-         * colour functions) and after (the specular terms) */
+        /* coherent fitting: the previous frame's line and where this pattern's terms are
+         * in it (plo..phi: its colour function, before Acc_mode) */
         const yp_cmdlist *pl = s->o->prev ? &s->o->prev[c * s->H + y] : NULL;
-        int pacc = 0;
-        while (pl && pacc < pl->n && pl->c[pacc].op != YP_ACCMODE) pacc++;
+        int plo = 0, phi = 0;
+        if (pl && !L->pbuilt && !prev_spans(L, pl)) return HSR_ENOMEM;
+        if (pl) prev_span(L, term, &plo, &phi);
         const double hyst = s->o->coherent ? YP_COH_HYST : 1;
         for (int lev = 1; lev <= e->maxlev && st == HSR_OK; lev++) {
             /* target: cov * colour over the covered pixels (Dis elsewhere) */
@@ -244,26 +339,40 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
                 ea = cov[a - x0] < 1 && cv[1];
                 eb = cov[cl - x0] < 1 && cv[n - 2];
             }
-            st = push_dis(&s->wl[lev], cv, a + ea, a + n - eb, a);
-            if (st == HSR_OK && yp_fit_coherent(f + ea, cv + ea, tv + ea, n - ea - eb, a + ea, lev - 1, tol, 0, hyst, pl, 0, pacc,
-                                                &s->wl[lev], NULL) < 0)
+            /* with the previous frame's line (if any) into wl[lev] and, with one, the same
+             * term without it into wpl: Dis, the fit without prev (wfit) and the edges'
+             * Eval1s of this frame */
+            yp_cmdlist *w = &s->wl[lev], *wp = &s->wpl;
+            w->n = w->slots = wp->n = wp->slots = s->wfit.n = s->wfit.slots = 0;
+            st = push_dis(w, cv, a + ea, a + n - eb, a);
+            if (st == HSR_OK && pl) st = push_dis(wp, cv, a + ea, a + n - eb, a);
+            if (st == HSR_OK && yp_fit_coherent(f + ea, cv + ea, tv + ea, n - ea - eb, a + ea, lev - 1, tol, 0, hyst, pl, plo, phi,
+                                                term, w, pl ? &s->wfit : NULL, NULL) < 0)
                 st = HSR_ELIMIT;
+            if (st == HSR_OK && pl) st = append(wp, &s->wfit);
             for (int k = 0; k < 2 && st == HSR_OK; k++) {
                 if (!(k ? eb : ea)) continue;
                 int x = k ? cl : a;
-                yp_cmd e1 = {YP_EVAL, 0, (uint16_t)x, 1, {q24(f[x - a]), 0, 0}};
-                /* the previous frame's Eval1 of this pixel stays while within cov * tol of
-                 * the target: the pixel's error, summed over the patterns sharing it, stays
-                 * within tol, as on a fully covered pixel */
-                for (int i = 0; pl && i < pacc; i++) {
+                yp_cmd e1 = {YP_EVAL, 0, (uint16_t)x, 1, {q24(f[x - a]), 0, 0}, 0};
+                if (pl) st = yp_cmdlist_push(wp, e1);
+                /* the previous frame's Eval1 of this pixel (this pattern's: the pattern on
+                 * the other side of the edge has one at this pixel too) stays while within
+                 * cov * tol of the target: the pixel's error, summed over the patterns
+                 * sharing it, stays within tol, as on a fully covered pixel */
+                for (int i = plo; pl && i < phi; i++) {
                     const yp_cmd *q = &pl->c[i];
-                    if (q->op == YP_EVAL && q->order == 0 && q->x == x && q->dx == 1
+                    if (q->op == YP_EVAL && q->order == 0 && q->x == x && q->dx == 1 && q->term == term
                         && fabs((double)q->v[0] / YP_ONE - f[x - a]) <= cov[x - x0] * tol) { e1 = *q; break; }
                 }
-                st = yp_cmdlist_push(&s->wl[lev], e1);
+                if (st == HSR_OK) st = yp_cmdlist_push(w, e1);
             }
-            if (st == HSR_OK) st = arena_list(&s->ar, &s->wl[lev], &e->lv[lev]);
+            set_term(w, term);
+            set_term(wp, term);
+            if (st == HSR_OK) st = arena_list(&s->ar, w, &e->lv[lev]);
+            if (st == HSR_OK && pl) st = arena_list(&s->ar, wp, &e->plv[lev]);
+            if (!pl) e->plv[lev] = e->lv[lev];
             e->cost[lev] = e->lv[lev].slots;
+            e->pcost[lev] = e->plv[lev].slots;
         }
         for (int l = 0; l < nl && st == HSR_OK && nsep; l++) {
             if (!sep[l]) continue;
@@ -271,22 +380,46 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             unsigned char *use = s->use2;
             for (int x = a; x <= cl; x++)
                 if (full[x] && s->fs[3 * nl * x + 3 * l + c] > ltol) { if (sa < 0) sa = x; sb = x; }
-            /* coherent: a specular term of the previous frame that starts at or left of sa
-             * over fully covered pixels keeps its start (its end grows if need be), so its
-             * Sets can stay; not if it is more than twice (and 32 pixels) longer */
-            for (int i = pacc + 1; pl && i < pl->n; i++) {
-                const yp_cmd *e = &pl->c[i];
-                int ea = e->x, eb = e->x + e->dx - 1 > sb ? e->x + e->dx - 1 : sb, okr = 1;
-                if (e->op != YP_EVAL || e->order != 2 || ea > sa || ea < a || eb > cl || eb + 1 - ea > 2 * (sb + 1 - sa) + 32) continue;
-                for (int x = ea; x <= eb && okr; x++) okr = full[x];
-                if (okr) { sa = ea; sb = eb; break; }
+            /* pass 0 with the previous frame's line (if any) into wspec, pass 1 without it
+             * into wpspec: the fit without prev that pass 0 made (wfit) if the span did not
+             * change, else a fit of its own */
+            const int fa = sa, fb = sb;
+            for (int pass = 0; pass < 1 + (pl != NULL) && st == HSR_OK; pass++) {
+                const yp_cmdlist *pp = pass ? NULL : pl;
+                yp_cmdlist *w = pass ? &s->wpspec : &s->wspec;
+                const int n0 = w->n;
+                if (pass && sa == fa && sb == fb) {
+                    st = push_dis(w, use, sa, sb + 1, sa);
+                    if (st == HSR_OK) st = append(w, &s->wfit);
+                } else {
+                    sa = fa; sb = fb;
+                    /* coherent: a specular term of the previous frame that starts at or left
+                     * of sa over fully covered pixels keeps its start (its end grows if need
+                     * be), so its Sets can stay; not if it is more than twice (and 32 pixels)
+                     * longer */
+                    int slo = 0, shi = 0;
+                    if (pp) prev_span(L, sterm[l], &slo, &shi);
+                    for (int i = slo; i < shi; i++) {
+                        const yp_cmd *e = &pp->c[i];
+                        int ea = e->x, eb = e->x + e->dx - 1 > sb ? e->x + e->dx - 1 : sb, okr = 1;
+                        if (e->op != YP_EVAL || e->order != 2 || e->term != sterm[l] || ea > sa || ea < a || eb > cl
+                            || eb + 1 - ea > 2 * (sb + 1 - sa) + 32) continue;
+                        for (int x = ea; x <= eb && okr; x++) okr = full[x];
+                        if (okr) { sa = ea; sb = eb; break; }
+                    }
+                    for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
+                    s->wfit.n = s->wfit.slots = 0;
+                    st = push_dis(w, use, sa, sb + 1, sa);
+                    if (st == HSR_OK && yp_fit_coherent(f, use, NULL, sb + 1 - sa, sa, 2, ltol, 1, hyst, pp, slo, shi,
+                                                        sterm[l], w, pp ? &s->wfit : NULL, NULL) < 0)
+                        st = HSR_ELIMIT;
+                }
+                for (int i = n0; i < w->n; i++) w->c[i].term = (uint16_t)sterm[l];
             }
-            for (int x = sa; x <= sb; x++) { f[x - sa] = full[x] ? s->fs[3 * nl * x + 3 * l + c] : 0; use[x - sa] = full[x]; }
-            st = push_dis(&s->wspec, use, sa, sb + 1, sa);
-            if (st == HSR_OK && yp_fit_coherent(f, use, NULL, sb + 1 - sa, sa, 2, ltol, 1, hyst, pl, pacc, pl ? pl->n : 0, &s->wspec, NULL) < 0)
-                st = HSR_ELIMIT;
         }
         if (st == HSR_OK) st = arena_list(&s->ar, &s->wspec, &e->spec);
+        if (st == HSR_OK && pl) st = arena_list(&s->ar, &s->wpspec, &e->pspec);
+        if (!pl) e->pspec = e->spec;
         /* the texture term: cov * texture over the covered pixels, one Eval3 spline whose
          * knots do not depend on the lights (docs/yproc.md section 11) */
         if (st == HSR_OK && any_tex && ltex) {
@@ -297,12 +430,14 @@ static hsr_status row_entry(scan *s, const int *par, int nvis, int y, const doub
             }
             st = push_dis(&s->wtex, cv, a, a + n, a);
             if (st == HSR_OK && yp_fit(f, cv, tv, n, a, 2, ltol, 0, &s->wtex) < 0) st = HSR_ELIMIT;
+            set_term(&s->wtex, term);
             if (st == HSR_OK) st = arena_list(&s->ar, &s->wtex, &e->tex);
-            for (int lev = 1; lev <= e->maxlev; lev++) e->cost[lev] += e->tex.slots;
+            for (int lev = 1; lev <= e->maxlev; lev++) { e->cost[lev] += e->tex.slots; e->pcost[lev] += e->tex.slots; }
         }
         if (st != HSR_OK) return st;
         e->spec_cost = e->spec.slots;
-        if (e->maxlev == 3) e->cost[3] += e->spec.slots;
+        e->pspec_cost = e->pspec.slots;
+        if (e->maxlev == 3) { e->cost[3] += e->spec.slots; e->pcost[3] += e->pspec.slots; }
         e->lev = e->maxlev;
     }
     return HSR_OK;
@@ -314,12 +449,14 @@ static int ent_area_cmp(const void *pa, const void *pb)
     return a->area < b->area ? -1 : a->area > b->area;
 }
 
-static int line_cost(entry **e, int n, int *spec, int base)
+/* slots of the line at the entries' levels: their terms (plain 0) or those fitted
+ * without the previous frame (plain 1) */
+static int line_cost(entry **e, int n, int *spec, int base, int plain)
 {
     int t = base, sp = 0;
     for (int i = 0; i < n; i++) {
-        t += e[i]->cost[e[i]->lev];
-        if (e[i]->lev == 3 && e[i]->spec_cost) sp = 1;
+        t += plain ? e[i]->pcost[e[i]->lev] : e[i]->cost[e[i]->lev];
+        if (e[i]->lev == 3 && (plain ? e[i]->pspec_cost : e[i]->spec_cost)) sp = 1;
     }
     if (spec) *spec = sp;
     return t + sp;
@@ -356,7 +493,7 @@ static hsr_status background_image(scan *s, int y, int c, yp_cmdlist *out)
         if (cs[x] > 0) { if (first < 0) first = x; last = x; x++; continue; }
         int v = (int)lround(yp_bg(s->sh, c, x, y)), a = x;
         while (x < s->W && cs[x] <= 0 && (int)lround(yp_bg(s->sh, c, x, y)) == v) x++;
-        yp_cmd e0 = {YP_EVAL0, 0, (uint16_t)a, (uint16_t)(x - a), {v, 0, 0}};
+        yp_cmd e0 = {YP_EVAL0, 0, (uint16_t)a, (uint16_t)(x - a), {v, 0, 0}, 0};
         st = yp_cmdlist_push(out, e0);
     }
     if (first < 0 || st != HSR_OK) return st;
@@ -393,7 +530,7 @@ static hsr_status finish_line(scan *s, int y, int c)
     yp_cmdlist bgl = {0};
     hsr_status st0;
     if (!s->sh->img) {
-        yp_cmd bg = {YP_EVAL, 0, 0, (uint16_t)s->W, {q24(s->sh->bg[c] + 0.5), 0, 0}};
+        yp_cmd bg = {YP_EVAL, 0, 0, (uint16_t)s->W, {q24(s->sh->bg[c] + 0.5), 0, 0}, 0};
         st0 = yp_cmdlist_push(&bgl, bg);
     } else st0 = background_image(s, y, c, &bgl);
     entry **ord = malloc(sizeof(entry *) * (size_t)(n + 1));
@@ -403,47 +540,57 @@ static hsr_status finish_line(scan *s, int y, int c)
     /* section 7.5: lower the colour function of the least visible
      * patterns first, Eval3 -> Eval2 for all, then Eval2 -> Eval1 */
     /* the line's cost (line_cost) is kept up to date as patterns are lowered,
-     * not recounted per pattern: O(n) instead of O(n^2) on a busy line */
+     * not recounted per pattern: O(n) instead of O(n^2) on a busy line.  With a previous
+     * frame (coherent fitting) the levels are chosen on the costs of the terms fitted
+     * without it: they depend on this frame only, so a line fitted again against its own
+     * commands gets the same levels (docs/yproc.md section 11.1) */
     int sum = bgl.slots, nsp = 0;
     for (int i = 0; i < n; i++) {
-        sum += L->e[i]->cost[L->e[i]->lev];
-        nsp += L->e[i]->lev == 3 && L->e[i]->spec_cost;
+        sum += L->e[i]->pcost[L->e[i]->lev];
+        nsp += L->e[i]->lev == 3 && L->e[i]->pspec_cost;
     }
     for (int lev = 3; lev >= 2 && !s->o->no_degrade && sum + (nsp > 0) > s->o->capacity; lev--)
         for (int i = 0; i < n && sum + (nsp > 0) > s->o->capacity; i++)
-            if (ord[i]->lev == lev && ord[i]->cost[lev - 1] < ord[i]->cost[lev]) {
-                sum -= ord[i]->cost[lev] - ord[i]->cost[lev - 1];
-                if (lev == 3 && ord[i]->spec_cost) nsp--;
+            if (ord[i]->lev == lev && ord[i]->pcost[lev - 1] < ord[i]->pcost[lev]) {
+                sum -= ord[i]->pcost[lev] - ord[i]->pcost[lev - 1];
+                if (lev == 3 && ord[i]->pspec_cost) nsp--;
                 ord[i]->lev = lev - 1;
             }
     free(ord);
-    int cost = line_cost(L->e, n, &sp, bgl.slots);
     ls->degraded[c] = 0;
     for (int i = 0; i < n; i++) if (L->e[i]->lev < L->e[i]->maxlev) ls->degraded[c]++;
     yp_cmdlist *out = &s->fr->line[c * s->H + y];
     yp_cmdlist_free(out);
     hsr_status st = HSR_OK;
     ls->merged[c] = ls->overflow[c] = 0;
-    if (cost <= s->o->capacity || s->o->no_degrade) {
+    /* the line of the terms (coherent: kept from the previous frame where they still fit)
+     * and, if it does not fit or wraps, with a previous frame, the line of the terms fitted
+     * without it, which the levels were chosen for */
+    int done = 0;
+    for (int plain = 0; plain <= (s->o->prev != NULL) && !done && st == HSR_OK; plain++) {
+        int cost = line_cost(L->e, n, &sp, bgl.slots, plain);
+        if (cost > s->o->capacity && !s->o->no_degrade) continue;
+        yp_cmdlist_free(out);
         st = append(out, &bgl);
         for (int i = 0; i < n && st == HSR_OK; i++) {
-            st = append(out, &L->e[i]->lv[L->e[i]->lev]);
+            st = append(out, plain ? &L->e[i]->plv[L->e[i]->lev] : &L->e[i]->lv[L->e[i]->lev]);
             if (st == HSR_OK) st = append(out, &L->e[i]->tex);
         }
         if (sp && st == HSR_OK) {
-            yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}};
+            yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}, 0};
             st = yp_cmdlist_push(out, am);
             for (int i = 0; i < n && st == HSR_OK; i++)
-                if (L->e[i]->lev == 3) st = append(out, &L->e[i]->spec);
+                if (L->e[i]->lev == 3) st = append(out, plain ? &L->e[i]->pspec : &L->e[i]->spec);
         }
         /* The array wraps (docs/isa.md section 1): a pixel whose exact value
          * is within the fit tolerance of 0 or 4096 could come out as its
          * opposite.  Check the line with the array model; if it happens, the
          * line takes the merged form below, whose targets keep clear of both. */
-        if (st == HSR_OK && wraps(s, out, y, c)) cost = s->o->capacity + 1;
-        else if (cost > s->o->capacity) ls->overflow[c] = 1;   /* no_degrade: as is, the controller drops it */
+        if (st == HSR_OK && wraps(s, out, y, c)) continue;
+        if (cost > s->o->capacity) ls->overflow[c] = 1;   /* no_degrade: as is, the controller drops it */
+        done = 1;
     }
-    if (st == HSR_OK && cost > s->o->capacity && !ls->overflow[c]) {
+    if (st == HSR_OK && !done) {
         /* Even Eval1 for every pattern does not fit: the last resort
          * before dropping anything is one spline for the whole line
          * through the exact target values, with a tolerance raised until
@@ -651,11 +798,12 @@ hsr_status yp_scan(const yp_shader *sh, const hsr_ctx *h, const yp_options *o, i
 done:
     if (s.le) {
         for (int i = 0; i < 3 * (y1 - y0); i++) {
-            free(s.le[i].e);
+            free(s.le[i].e); free(s.le[i].term); free(s.le[i].ps);
         }
     }
     arena_free(&s.ar);
     for (int i = 0; i < 4; i++) yp_cmdlist_free(&s.wl[i]);
+    yp_cmdlist_free(&s.wpl); yp_cmdlist_free(&s.wpspec); yp_cmdlist_free(&s.wfit);
     yp_cmdlist_free(&s.wspec); yp_cmdlist_free(&s.wtex); free(s.fx);
     free(s.le); free(keys); free(acc); free(mark); free(s.fb); free(s.fs); free(s.ft); free(s.tmp); free(s.tolv); free(s.covsum); free(s.use); free(s.use2);
     return st;

@@ -28,32 +28,32 @@ static void add(pair *p, yp_cmd y, fm_cmd f)
 /* Eval of order 0..2 (Eval1..Eval3): values I, dI, ddI */
 static void eval(pair *p, int x, int dx, int order, int64_t i, int64_t di, int64_t ddi)
 {
-    yp_cmd y = {YP_EVAL, (uint8_t)order, (uint16_t)x, (uint16_t)dx, {i, di, ddi}};
+    yp_cmd y = {YP_EVAL, (uint8_t)order, (uint16_t)x, (uint16_t)dx, {i, di, ddi}, 0};
     fm_cmd f = {FM_EVAL, x, dx, order + 1, {i, di, ddi}};
     add(p, y, f);
 }
 static void eval0(pair *p, int x, int dx, int v)
 {
-    yp_cmd y = {YP_EVAL0, 0, (uint16_t)x, (uint16_t)dx, {v, 0, 0}};
+    yp_cmd y = {YP_EVAL0, 0, (uint16_t)x, (uint16_t)dx, {v, 0, 0}, 0};
     fm_cmd f = {FM_EVAL0, x, dx, 1, {v}};
     add(p, y, f);
 }
 /* r = 0, 1, 2: SetI, SetdI, SetddI */
 static void set(pair *p, int r, int x, int dx, int64_t v)
 {
-    yp_cmd y = {(uint8_t)(YP_SETI + r), 0, (uint16_t)x, (uint16_t)dx, {v, 0, 0}};
+    yp_cmd y = {(uint8_t)(YP_SETI + r), 0, (uint16_t)x, (uint16_t)dx, {v, 0, 0}, 0};
     fm_cmd f = {FM_SETI + r, x, dx, 1, {v}};
     add(p, y, f);
 }
 static void dis(pair *p, int x, int dx)
 {
-    yp_cmd y = {YP_DIS, 0, (uint16_t)x, (uint16_t)dx, {0, 0, 0}};
+    yp_cmd y = {YP_DIS, 0, (uint16_t)x, (uint16_t)dx, {0, 0, 0}, 0};
     fm_cmd f = {FM_DIS, x, dx, 0, {0}};
     add(p, y, f);
 }
 static void accmode(pair *p, int on)
 {
-    yp_cmd y = {YP_ACCMODE, 0, 0, 0, {on, 0, 0}};
+    yp_cmd y = {YP_ACCMODE, 0, 0, 0, {on, 0, 0}, 0};
     fm_cmd f = {FM_ACCMODE, 0, 0, 1, {on}};
     add(p, y, f);
 }
@@ -163,7 +163,7 @@ static void test_errors_give_a_status_and_a_black_line(void)
     CHECK(yp_simulate_line(NULL, 8, pix) == HSR_EINVAL && pix[3] == 0);
     CHECK(yp_simulate_line(&p.yp, 0, pix) == HSR_EINVAL);
     /* a Refresh inside the list would end the line: a list is one line */
-    yp_cmd r = {YP_REFRESH, 0, 0, 0, {0, 0, 0}};
+    yp_cmd r = {YP_REFRESH, 0, 0, 0, {0, 0, 0}, 0};
     CHECK(yp_cmdlist_push(&p.yp, r) == HSR_OK);
     memset(pix, 0xff, sizeof pix);
     CHECK(yp_simulate_line(&p.yp, 8, pix) == HSR_EINVAL && pix[0] == 0 && pix[7] == 0);

@@ -260,7 +260,7 @@ static void test_yp_quadratic_fit_error_bound_against_exact_phong(void)
         int nk = yp_fit(f, use, NULL, N, 20, 2, tol, 0, &l);
         CHECK(nk > 0 && l.n == nk + 1);
         yp_cmdlist line = {0};
-        yp_cmd bg = {YP_EVAL, 0, 0, 640, {(int64_t)(0.5 * YP_ONE), 0, 0}};
+        yp_cmd bg = {YP_EVAL, 0, 0, 640, {(int64_t)(0.5 * YP_ONE), 0, 0}, 0};
         yp_cmdlist_push(&line, bg);
         for (int i = 0; i < l.n; i++) yp_cmdlist_push(&line, l.c[i]);
         uint16_t pix[640];
@@ -293,7 +293,7 @@ static void test_yp_acc_mode_clamps_negative_specular_tails(void)
     CHECK(neg > 0);
     /* ... and with Acc_mode those columns contribute 0, without it they wrap */
     yp_cmdlist on = {0}, off = {0};
-    yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}}, half = {YP_EVAL, 0, 0, N, {(int64_t)(0.5 * YP_ONE), 0, 0}};
+    yp_cmd am = {YP_ACCMODE, 0, 0, 0, {1, 0, 0}, 0}, half = {YP_EVAL, 0, 0, N, {(int64_t)(0.5 * YP_ONE), 0, 0}, 0};
     yp_cmdlist_push(&on, half); yp_cmdlist_push(&off, half);
     yp_cmdlist_push(&on, am);
     for (int i = 0; i < l.n; i++) { yp_cmdlist_push(&on, l.c[i]); yp_cmdlist_push(&off, l.c[i]); }

@@ -145,8 +145,8 @@ static void test_wander_moves_continuously_towards_random_points_in_its_box(void
 static void test_changed_slots_is_the_lcs_of_the_commands(void)
 {
     yp_cmdlist a = {0}, b = {0};
-    yp_cmd e3 = {YP_EVAL, 2, 0, 40, {1, 2, 3}}, s1 = {YP_SETDDI, 0, 5, 0, {7, 0, 0}}, s2 = {YP_SETDDI, 0, 9, 0, {8, 0, 0}};
-    yp_cmd bg = {YP_EVAL, 0, 0, 48, {100, 0, 0}}, e3b = e3;
+    yp_cmd e3 = {YP_EVAL, 2, 0, 40, {1, 2, 3}, 0}, s1 = {YP_SETDDI, 0, 5, 0, {7, 0, 0}, 0}, s2 = {YP_SETDDI, 0, 9, 0, {8, 0, 0}, 0};
+    yp_cmd bg = {YP_EVAL, 0, 0, 48, {100, 0, 0}, 0}, e3b = e3;
     e3b.v[0] = 99;
     /* a: bg s1 e3 s2 e3 ; b: bg s1 e3b s2 e3 -> one Eval3 (5 slots) changed */
     yp_cmd la[] = {bg, s1, e3, s2, e3}, lb[] = {bg, s1, e3b, s2, e3};
