@@ -18,7 +18,8 @@ module chip_top #(
   parameter int unsigned NumPe    = 9,
   parameter int unsigned CarryBug = 0,
   parameter int unsigned Compact  = 0,   // de_pe Compact (1: the iCE40 chip, which is full)
-  parameter int unsigned TieBypass = 0   // de_chip TieBypass (1: flow.py's what-if chip)
+  parameter int unsigned TieBypass = 0,  // de_chip TieBypass (1: flow.py's what-if chip)
+  parameter int unsigned InReg    = 1    // de_chip InReg
 ) (
   input  logic clk_i,
   input  logic rst_i,
@@ -95,7 +96,7 @@ module chip_top #(
   end
 
   de_chip #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .RstW(RstW),
-            .TieBypass(TieBypass)) u_chip (
+            .TieBypass(TieBypass), .InReg(InReg)) u_chip (
     .clk_i,
     .rst_i      (rst_q),
     // id, data, pix_valid, pix from the shift register; de_chip does not use link_i.coll

@@ -32,7 +32,14 @@ module de_pe
   parameter int unsigned IdCopy = 0,
   // Timing only: 1 = pixv_c_o is a register of its own (a copy of the pixel-valid register
   // for the chip's collision flag and valid chain); 0 = pixv_c_o is pix_valid_o.
-  parameter int unsigned PixCopy = 0
+  parameter int unsigned PixCopy = 0,
+  // 1 = the PE registers its own inputs (id_i, data_i) before stage 0, and computes from
+  // them, a cycle early, what stage 0 would otherwise compute behind the input: block 1's
+  // zero test, X - 1, and the SRC/DST operands of stage 0 (from the register blocks' next
+  // values). The PE then takes two clocks on the bus instead of one; its registers see
+  // the same slots in the same order, one clock later (docs/xproc.md section 9).
+  // blk1z_i and idsel_i are not read, blk1z_o is not driven (constant). Not Compact.
+  parameter int unsigned InReg = 0
 ) (
   input  logic             clk_i,
   // Synchronous, active high. RstW copies of ONE reset, equal in every cycle (registered
@@ -79,6 +86,9 @@ module de_pe
   end
   if (RstW < 1 || RstW > 4) begin : g_bad_rst_w
     $fatal(1, "de_pe: RstW must be 1..4, got %0d", RstW);
+  end
+  if (InReg > 1 || (InReg == 1 && Compact == 1)) begin : g_bad_in_reg
+    $fatal(1, "de_pe: InReg must be 0 or 1, and 0 when Compact, got %0d", InReg);
   end
   if (AddCarryBlk == 1) begin : g_bad_carry_blk
     // blk1z_d's zero test of a block-1 sum takes the carry into bit 0 (zero_terms).
@@ -144,8 +154,20 @@ module de_pe
   /* verilator lint_off UNUSEDSIGNAL */
   id_t id1, id2;
   /* verilator lint_on UNUSEDSIGNAL */
-  assign in_blk = data_i;
-  assign id0 = id_t'(id_i);
+  // InReg: the input registers (in_id_q, in_data_q) and, beside them, what stage 0 needs
+  // of the slot alone, computed from the unregistered input a cycle early.
+  logic [IdW-1:0]   in_id_q;
+  logic [DataW-1:0] in_data_q;
+  logic             in_z1_q;      // block 1 of in_data_q is zero (blk1z_i's job)
+  logic [BlkW:0]    in_dm0_q;     // {carry, X - 1} of block 0 of in_data_q
+  logic [BlkW-1:0]  src0_q, dst0_q;  // stage 0's SRC and DST, selected a cycle early
+  if (InReg == 1) begin : g_in_reg
+    assign in_blk = in_data_q;
+    assign id0    = id_t'(in_id_q);
+  end else begin : g_in_wire
+    assign in_blk = data_i;
+    assign id0    = id_t'(id_i);
+  end
   assign id1 = id_t'(id_q);
   assign id2 = id_t'(id2_q);
 
@@ -160,7 +182,7 @@ module de_pe
   // The zero test of block 1 is made by the sender, from its own candidates for the
   // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below). A
   // Compact PE tests the block itself and leaves the flag unused (fewer cells).
-  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : blk1z_i;
+  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : ((InReg == 1) ? in_z1_q : blk1z_i);
   // = id1.addr && (id1.sub == SubPeriodic), registered beside id_q (per1_q; not Compact).
   assign per1      = (Compact == 1) ? (id1.addr && (id1.sub == SubPeriodic)) : per1_q;
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
@@ -179,8 +201,9 @@ module de_pe
   assign rng0    = id0.addr && (id0.sub != SubPeriodic);
   // X - 1 as a constant decrement with its carry out: the carry is 1 unless X is 0, so the
   // zero test of X comes out of the same carry chain, not from two LUT levels of its own.
+  // InReg: computed a cycle early (in_dm0_q).
   (* keep *) logic [BlkW:0] dm0;
-  assign dm0     = {1'b0, in_blk[0]} + {1'b0, {BlkW{1'b1}}};
+  assign dm0     = (InReg == 1) ? in_dm0_q : {1'b0, in_blk[0]} + {1'b0, {BlkW{1'b1}}};
   assign xz0     = !dm0[BlkW];
   // Protection is decided once per slot, here, and travels with it down the pipeline;
   // pv0 is the part that does not depend on act_eff.
@@ -192,10 +215,14 @@ module de_pe
   id_t id0s;
   /* verilator lint_on UNUSEDSIGNAL */
   assign id0s    = (IdCopy == 1) ? id_t'(idsel_i) : id0;
-  assign src0    = reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
+  // InReg: both operands come from registers (src0_q, dst0_q), so the adder starts at a
+  // flip-flop rather than behind the identifier's decode.
+  logic [BlkW-1:0] dst0;
+  assign src0    = (InReg == 1) ? src0_q : reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
+  assign dst0    = (InReg == 1) ? dst0_q : reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0]);
   // v0 + SRC0 with v0 = prot0 ? DST0 : in0: both sums are formed while act_eff is still
   // being decided and pv0 picks one after the adders (carry select on the operand).
-  assign sp0     = {1'b0, reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0])} + {1'b0, src0};
+  assign sp0     = {1'b0, dst0} + {1'b0, src0};
   assign sn0     = {1'b0, in_blk[0]} + {1'b0, src0};
   assign s0      = pv0 ? sp0 : sn0;
   // A protected slot writes DST with DST's own value: no write. So a write is in0 only.
@@ -259,6 +286,16 @@ module de_pe
     assign pass1   = z1 ? ((per1 && live) ? out_q[0] - BlkW'(1) : '0)
                         : in_blk[1] - BlkW'(dec1);
     assign blk1z_d = (out1 == '0);
+  end else if (InReg == 1) begin : g_pass1_in_reg
+    // As g_pass1_fast, without the zero test for the next PE: it registers its own
+    // (in_z1_q) from its input, a cycle early.
+    logic seld1, selq1;
+    logic [BlkW-1:0] dm1;
+    assign seld1   = dec1 && !z1;
+    assign selq1   = z1 && per1 && live;
+    assign dm1     = in_blk[1] - BlkW'(1);
+    assign pass1   = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
+    assign blk1z_d = 1'b1;
   end else begin : g_pass1_fast
     // The decrement is a constant one (dm1) picked after the carry chain, so the chain
     // starts at the input block and not behind the decision: pass1 = z1 ? q1 : (dec1 ? dm1
@@ -480,13 +517,14 @@ module de_pe
     assign wr2   = wr2_q;
   end
   // (Compact: plain, blk1z_d does not use src1.)
-  assign src1_d = (sum0 || Compact == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
+  assign src1_d = (sum0 || Compact == 1 || InReg == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1])
+                                                       : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
 
   // ---- pipeline next state ----------------------------------------------------------------
-  assign id_d     = id_i;
+  assign id_d     = (InReg == 1) ? in_id_q : id_i;
   assign out_d    = {out2, out1, out0};
   assign id2_d    = id_q;
   assign xz1_d    = rng0 && xz0;
@@ -541,6 +579,44 @@ module de_pe
       per1_q  <= per1_d;
       src1_q  <= src1_d;
     end
+  end
+
+  // InReg: the input registers follow the bus (a bypassed PE passes its input through
+  // them), the operand registers the register blocks (all zero in reset and in bypass).
+  if (InReg == 1) begin : g_in_regs
+    id_t idn;
+    assign idn = id_t'(id_i);
+    always_ff @(posedge clk_i) begin
+      if (rst_bus) begin
+        in_id_q   <= '0;
+        in_data_q <= '0;
+        in_z1_q   <= 1'b1;
+        in_dm0_q  <= {1'b0, {BlkW{1'b1}}};
+      end else begin
+        in_id_q   <= id_i;
+        in_data_q <= data_i;
+        in_z1_q   <= (data_i[BlkW +: BlkW] == '0);
+        in_dm0_q  <= {1'b0, data_i[0 +: BlkW]} + {1'b0, {BlkW{1'b1}}};
+      end
+    end
+    // The slot on id_i now is in stage 0 next cycle and reads the register blocks as they
+    // stand after this cycle's writes: a_d, b_d, c_d.
+    always_ff @(posedge clk_i) begin
+      if (hold_ab) begin
+        src0_q <= '0;
+        dst0_q <= '0;
+      end else begin
+        src0_q <= reg_blk(idn.src, a_d[0], b_d[0], c_d[0]);
+        dst0_q <= reg_blk(idn.dst, a_d[0], b_d[0], c_d[0]);
+      end
+    end
+  end else begin : g_no_in_regs
+    assign in_id_q   = '0;
+    assign in_data_q = '0;
+    assign in_z1_q   = 1'b1;
+    assign in_dm0_q  = '0;
+    assign src0_q    = '0;
+    assign dst0_q    = '0;
   end
 
   // Everything else; a bypassed PE holds it in reset (no pixel, an all-zero state).
