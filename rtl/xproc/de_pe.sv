@@ -218,8 +218,8 @@ module de_pe
   // InReg: both operands come from registers (src0_q, dst0_q), so the adder starts at a
   // flip-flop rather than behind the identifier's decode.
   logic [BlkW-1:0] dst0;
-  assign src0    = (InReg == 1) ? src0_q : reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
-  assign dst0    = (InReg == 1) ? dst0_q : reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0]);
+  assign src0    = reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
+  assign dst0    = reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0]);
   // v0 + SRC0 with v0 = prot0 ? DST0 : in0: both sums are formed while act_eff is still
   // being decided and pv0 picks one after the adders (carry select on the operand).
   assign sp0     = {1'b0, dst0} + {1'b0, src0};
@@ -601,15 +601,8 @@ module de_pe
     end
     // The slot on id_i now is in stage 0 next cycle and reads the register blocks as they
     // stand after this cycle's writes: a_d, b_d, c_d.
-    always_ff @(posedge clk_i) begin
-      if (hold_ab) begin
-        src0_q <= '0;
-        dst0_q <= '0;
-      end else begin
-        src0_q <= reg_blk(idn.src, a_d[0], b_d[0], c_d[0]);
-        dst0_q <= reg_blk(idn.dst, a_d[0], b_d[0], c_d[0]);
-      end
-    end
+    assign src0_q = '0;
+    assign dst0_q = '0;
   end else begin : g_no_in_regs
     assign in_id_q   = '0;
     assign in_data_q = '0;
