@@ -193,7 +193,7 @@ module de_pe
   assign act_eff   = z1 ? aez_q : aenz_q;
 
   // ---- stage 0: identifier + block 0 ---------------------------------------------------
-  logic ev0, st0, rng0, xz0, pv0, prot0, active0, wr0;
+  logic ev0, st0, rng0, xz0, pv0, prot0, wr0;
   logic [BlkW-1:0] src0, out0;
   logic [BlkW:0] sp0, sn0, s0;
   assign ev0     = id0.data && !id0.set;
@@ -209,12 +209,12 @@ module de_pe
   // pv0 is the part that does not depend on act_eff.
   assign pv0     = ev0 && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
   assign prot0   = act_eff && pv0;
-  assign active0 = ev0 && act_eff;
   // The operand selects read their own copy of the identifier (IdCopy; equal to id0).
   /* verilator lint_off UNUSEDSIGNAL */
   id_t id0s;
   /* verilator lint_on UNUSEDSIGNAL */
-  assign id0s    = (IdCopy == 1) ? id_t'(idsel_i) : id0;
+  logic [IdW-1:0] in_idsel_q;  // InReg: a kept copy of in_id_q for the operand selects
+  assign id0s    = (InReg == 1) ? id_t'(in_idsel_q) : (IdCopy == 1) ? id_t'(idsel_i) : id0;
   // InReg: both operands come from registers (src0_q, dst0_q), so the adder starts at a
   // flip-flop rather than behind the identifier's decode.
   logic [BlkW-1:0] dst0;
@@ -238,9 +238,14 @@ module de_pe
   // sn0, pass0 (one PFUMX) rather than a 7-input function of the decisions.
   // Relative addressing counts X down to 0 and keeps it there: pass0 picks X, X - 1 or 0
   // after the decrement (a LUT4 of rng0l, the carry, the two bits).
-  (* keep *) logic sum0, rng0l;
+  // sum0 = ev0 && act_eff && live, for both outcomes of the zero test (kept nets); z1
+  // picks one in the out0 logic itself: one routed hop from the zero test to out_q[0].
+  (* keep *) logic sum0z, sum0nz, rng0l;
   (* keep *) logic [BlkW-1:0] pass0;
-  assign sum0  = active0 && live;
+  logic sum0;
+  assign sum0z  = ev0 && aez_q && live;
+  assign sum0nz = ev0 && aenz_q && live;
+  assign sum0   = z1 ? sum0z : sum0nz;
   assign rng0l = rng0 && live;
   assign pass0 = rng0l ? (xz0 ? '0 : dm0[BlkW-1:0]) : in_blk[0];
   assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
@@ -531,7 +536,7 @@ module de_pe
   assign per1_d   = id0.addr && (id0.sub == SubPeriodic);
   assign act1_d   = act_eff;
   assign prot1_d  = prot0;
-  assign c1_d     = sum0 && s0[BlkW];     // = active0 && s0[BlkW] (in bypass c1_q is held in reset)
+  assign c1_d     = sum0 && s0[BlkW];     // (in bypass c1_q is held in reset)
   assign act2_d   = act1_q;
   assign prot2_d  = prot1_q;
   assign c2_d     = active1 && s1[BlkW];
@@ -586,14 +591,23 @@ module de_pe
   if (InReg == 1) begin : g_in_regs
     id_t idn;
     assign idn = id_t'(id_i);
+    // in_id_q and its copy, each bit a kept process (or opt_merge folds the copy).
+    for (genvar k = 0; k < IdW; k++) begin : g_in_id_bit
+      (* keep *) always_ff @(posedge clk_i) begin
+        if (rst_bus) in_id_q[k] <= 1'b0;
+        else         in_id_q[k] <= id_i[k];
+      end
+      (* keep *) always_ff @(posedge clk_i) begin
+        if (rst_bus) in_idsel_q[k] <= 1'b0;
+        else         in_idsel_q[k] <= id_i[k];
+      end
+    end
     always_ff @(posedge clk_i) begin
       if (rst_bus) begin
-        in_id_q   <= '0;
         in_data_q <= '0;
         in_z1_q   <= 1'b1;
         in_dm0_q  <= {1'b0, {BlkW{1'b1}}};
       end else begin
-        in_id_q   <= id_i;
         in_data_q <= data_i;
         in_z1_q   <= (data_i[BlkW +: BlkW] == '0);
         in_dm0_q  <= {1'b0, data_i[0 +: BlkW]} + {1'b0, {BlkW{1'b1}}};
@@ -604,6 +618,7 @@ module de_pe
     assign src0_q = '0;
     assign dst0_q = '0;
   end else begin : g_no_in_regs
+    assign in_idsel_q = '0;
     assign in_id_q   = '0;
     assign in_data_q = '0;
     assign in_z1_q   = 1'b1;
