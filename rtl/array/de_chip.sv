@@ -164,9 +164,13 @@ module de_chip_core
   logic [NumPe:0]            pixv_or;
   logic [NumPe-1:0][PixW-1:0] src_pix;  // what PE i puts on the pixel chain
   logic [NumPe-1:0]           src_pixv;
-  logic [NumPe-1:0][PixW-1:0] pe_pix_all;  // PE i's pixel register (zero when not valid)
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [NumPe-1:0][PixW-1:0] pe_pix_all;  // PE i's pixel register (InReg = 1's chain)
   logic [NumPe-1:0]           pe_pixv_all; // its valid bit (the copy, pe_pixvc)
-  logic [NumPe-1:0]          coll;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [NumPe-1:0]          coll;     // (InReg = 1: the collision travels on the chain)
+  /* verilator lint_on UNUSEDSIGNAL */
   logic [NumPe-1:0]          byp_d, byp_q;
   logic [NumPe-1:0][PeRstW-1:0] pe_byp;    // de_pe bypass_i (equal copies)
   logic [NumPe-1:0]          pe_live;          // de_pe live_i

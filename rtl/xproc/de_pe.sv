@@ -33,12 +33,12 @@ module de_pe
   // Timing only: 1 = pixv_c_o is a register of its own (a copy of the pixel-valid register
   // for the chip's collision flag and valid chain); 0 = pixv_c_o is pix_valid_o.
   parameter int unsigned PixCopy = 0,
-  // 1 = the PE registers its own inputs (id_i, data_i) before stage 0, and computes from
-  // them, a cycle early, what stage 0 would otherwise compute behind the input: block 1's
-  // zero test, X - 1, and the SRC/DST operands of stage 0 (from the register blocks' next
-  // values). The PE then takes two clocks on the bus instead of one; its registers see
-  // the same slots in the same order, one clock later (docs/xproc.md section 9).
-  // blk1z_i and idsel_i are not read, blk1z_o is not driven (constant). Not Compact.
+  // 1 = the PE registers its own input (id_i, data_i) before stage 0 and computes beside
+  // that register, a cycle early, what stage 0 would otherwise compute behind it: block
+  // 1's zero test, X - 1 and stage 0's SRC and DST operands (docs/xproc.md section 9).
+  // The PE then costs two clocks on the bus instead of one; its registers hold the same
+  // values for the same slots, one clock later. blk1z_i and idsel_i are not read and
+  // blk1z_o is constant (the next PE tests its own input). 0 when Compact.
   parameter int unsigned InReg = 0
 ) (
   input  logic             clk_i,
@@ -88,7 +88,7 @@ module de_pe
     $fatal(1, "de_pe: RstW must be 1..4, got %0d", RstW);
   end
   if (InReg > 1 || (InReg == 1 && Compact == 1)) begin : g_bad_in_reg
-    $fatal(1, "de_pe: InReg must be 0 or 1, and 0 when Compact, got %0d", InReg);
+    $fatal(1, "de_pe: InReg must be 0 or 1 (0 when Compact), got %0d", InReg);
   end
   if (AddCarryBlk == 1) begin : g_bad_carry_blk
     // blk1z_d's zero test of a block-1 sum takes the carry into bit 0 (zero_terms).
@@ -154,13 +154,15 @@ module de_pe
   /* verilator lint_off UNUSEDSIGNAL */
   id_t id1, id2;
   /* verilator lint_on UNUSEDSIGNAL */
-  // InReg: the input registers (in_id_q, in_data_q) and, beside them, what stage 0 needs
-  // of the slot alone, computed from the unregistered input a cycle early.
+  // InReg: the input register (in_id_q, in_data_q) and, beside it, what stage 0 needs,
+  // computed from the unregistered input a cycle early (registers g_in_regs, below).
   logic [IdW-1:0]   in_id_q;
-  logic [DataW-1:0] in_data_q;
-  logic             in_z1_q;      // block 1 of in_data_q is zero (blk1z_i's job)
-  logic [BlkW:0]    in_dm0_q;     // {carry, X - 1} of block 0 of in_data_q
-  logic [BlkW-1:0]  src0_q, dst0_q;  // stage 0's SRC and DST, selected a cycle early
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [DataW-1:0] in_data_q;       // (InReg = 0: unused)
+  /* verilator lint_on UNUSEDSIGNAL */
+  logic             in_z1_q;         // block 1 of in_data_q is zero (blk1z_i's job)
+  logic [BlkW:0]    in_dm0_q;        // {carry, X - 1} of block 0 of in_data_q
+  logic [BlkW-1:0]  src0_q, dst0_q;  // stage 0's SRC and DST blocks
   if (InReg == 1) begin : g_in_reg
     assign in_blk = in_data_q;
     assign id0    = id_t'(in_id_q);
@@ -182,7 +184,7 @@ module de_pe
   // The zero test of block 1 is made by the sender, from its own candidates for the
   // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below). A
   // Compact PE tests the block itself and leaves the flag unused (fewer cells).
-  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : ((InReg == 1) ? in_z1_q : blk1z_i);
+  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : (InReg == 1) ? in_z1_q : blk1z_i;
   // = id1.addr && (id1.sub == SubPeriodic), registered beside id_q (per1_q; not Compact).
   assign per1      = (Compact == 1) ? (id1.addr && (id1.sub == SubPeriodic)) : per1_q;
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
@@ -194,6 +196,9 @@ module de_pe
 
   // ---- stage 0: identifier + block 0 ---------------------------------------------------
   logic ev0, st0, rng0, xz0, pv0, prot0, wr0;
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic active0;  // (InReg = 1: sum0 is formed from its two halves)
+  /* verilator lint_on UNUSEDSIGNAL */
   logic [BlkW-1:0] src0, out0;
   logic [BlkW:0] sp0, sn0, s0;
   assign ev0     = id0.data && !id0.set;
@@ -209,17 +214,17 @@ module de_pe
   // pv0 is the part that does not depend on act_eff.
   assign pv0     = ev0 && id0.prot && reg_flag(id0.dst, pa_q, pb_q, pc_q);
   assign prot0   = act_eff && pv0;
+  assign active0 = ev0 && act_eff;
   // The operand selects read their own copy of the identifier (IdCopy; equal to id0).
   /* verilator lint_off UNUSEDSIGNAL */
   id_t id0s;
   /* verilator lint_on UNUSEDSIGNAL */
-  logic [IdW-1:0] in_idsel_q;  // InReg: a kept copy of in_id_q for the operand selects
-  assign id0s    = (InReg == 1) ? id_t'(in_idsel_q) : (IdCopy == 1) ? id_t'(idsel_i) : id0;
-  // InReg: both operands come from registers (src0_q, dst0_q), so the adder starts at a
-  // flip-flop rather than behind the identifier's decode.
+  assign id0s    = (IdCopy == 1) ? id_t'(idsel_i) : id0;
+  // InReg: both operands come from registers (src0_q, dst0_q), so the adders start at
+  // flip-flops rather than behind the identifier's decode.
   logic [BlkW-1:0] dst0;
-  assign src0    = reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
-  assign dst0    = reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0]);
+  assign src0    = (InReg == 1) ? src0_q : reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
+  assign dst0    = (InReg == 1) ? dst0_q : reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0]);
   // v0 + SRC0 with v0 = prot0 ? DST0 : in0: both sums are formed while act_eff is still
   // being decided and pv0 picks one after the adders (carry select on the operand).
   assign sp0     = {1'b0, dst0} + {1'b0, src0};
@@ -238,14 +243,21 @@ module de_pe
   // sn0, pass0 (one PFUMX) rather than a 7-input function of the decisions.
   // Relative addressing counts X down to 0 and keeps it there: pass0 picks X, X - 1 or 0
   // after the decrement (a LUT4 of rng0l, the carry, the two bits).
-  // sum0 = ev0 && act_eff && live, for both outcomes of the zero test (kept nets); z1
-  // picks one in the out0 logic itself: one routed hop from the zero test to out_q[0].
-  (* keep *) logic sum0z, sum0nz, rng0l;
+  (* keep *) logic rng0l;
   (* keep *) logic [BlkW-1:0] pass0;
   logic sum0;
-  assign sum0z  = ev0 && aez_q && live;
-  assign sum0nz = ev0 && aenz_q && live;
-  assign sum0   = z1 ? sum0z : sum0nz;
+  if (InReg == 1) begin : g_sum0_split
+    // sum0 for both outcomes of the zero test (kept nets), so that z1 picks one inside
+    // the out0 logic itself: one routed hop from the zero test to out_q[0].
+    (* keep *) logic sum0z, sum0nz;
+    assign sum0z  = ev0 && aez_q && live;
+    assign sum0nz = ev0 && aenz_q && live;
+    assign sum0   = z1 ? sum0z : sum0nz;
+  end else begin : g_sum0
+    (* keep *) logic sum0_k;
+    assign sum0_k = active0 && live;
+    assign sum0   = sum0_k;
+  end
   assign rng0l = rng0 && live;
   assign pass0 = rng0l ? (xz0 ? '0 : dm0[BlkW-1:0]) : in_blk[0];
   assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
@@ -292,10 +304,10 @@ module de_pe
                         : in_blk[1] - BlkW'(dec1);
     assign blk1z_d = (out1 == '0);
   end else if (InReg == 1) begin : g_pass1_in_reg
-    // As g_pass1_fast, without the zero test for the next PE: it registers its own
-    // (in_z1_q) from its input, a cycle early.
-    logic seld1, selq1;
-    logic [BlkW-1:0] dm1;
+    // As g_pass1_fast (the same kept nets), without the zero test for the next PE: it
+    // registers its own (in_z1_q) from its input, a cycle early.
+    (* keep *) logic seld1, selq1;
+    (* keep *) logic [BlkW-1:0] dm1;
     assign seld1   = dec1 && !z1;
     assign selq1   = z1 && per1 && live;
     assign dm1     = in_blk[1] - BlkW'(1);
@@ -522,8 +534,8 @@ module de_pe
     assign wr2   = wr2_q;
   end
   // (Compact: plain, blk1z_d does not use src1.)
-  assign src1_d = (sum0 || Compact == 1 || InReg == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1])
-                                                       : '1;
+  assign src1_d = (sum0 || Compact == 1 || InReg == 1) ?
+                  reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
@@ -536,7 +548,7 @@ module de_pe
   assign per1_d   = id0.addr && (id0.sub == SubPeriodic);
   assign act1_d   = act_eff;
   assign prot1_d  = prot0;
-  assign c1_d     = sum0 && s0[BlkW];     // (in bypass c1_q is held in reset)
+  assign c1_d     = sum0 && s0[BlkW];     // = active0 && s0[BlkW] (in bypass c1_q is held in reset)
   assign act2_d   = act1_q;
   assign prot2_d  = prot1_q;
   assign c2_d     = active1 && s1[BlkW];
@@ -586,39 +598,52 @@ module de_pe
     end
   end
 
-  // InReg: the input registers follow the bus (a bypassed PE passes its input through
-  // them), the operand registers the register blocks (all zero in reset and in bypass).
+  // InReg: the input register follows the bus (a bypassed PE passes its input through it,
+  // so it costs two clocks like a PE in use), the operand registers follow the register
+  // blocks (zero in reset and in bypass, as the blocks are).
   if (InReg == 1) begin : g_in_regs
+    // Only the register fields of the next slot's identifier are read here.
+    /* verilator lint_off UNUSEDSIGNAL */
     id_t idn;
+    /* verilator lint_on UNUSEDSIGNAL */
     assign idn = id_t'(id_i);
-    // in_id_q and its copy, each bit a kept process (or opt_merge folds the copy).
-    for (genvar k = 0; k < IdW; k++) begin : g_in_id_bit
-      (* keep *) always_ff @(posedge clk_i) begin
-        if (rst_bus) in_id_q[k] <= 1'b0;
-        else         in_id_q[k] <= id_i[k];
-      end
-      (* keep *) always_ff @(posedge clk_i) begin
-        if (rst_bus) in_idsel_q[k] <= 1'b0;
-        else         in_idsel_q[k] <= id_i[k];
-      end
-    end
     always_ff @(posedge clk_i) begin
       if (rst_bus) begin
+        in_id_q   <= '0;
         in_data_q <= '0;
         in_z1_q   <= 1'b1;
         in_dm0_q  <= {1'b0, {BlkW{1'b1}}};
       end else begin
+        in_id_q   <= id_i;
         in_data_q <= data_i;
         in_z1_q   <= (data_i[BlkW +: BlkW] == '0);
         in_dm0_q  <= {1'b0, data_i[0 +: BlkW]} + {1'b0, {BlkW{1'b1}}};
       end
     end
     // The slot on id_i now is in stage 0 next cycle and reads the register blocks as they
-    // stand after this cycle's writes: a_d, b_d, c_d.
-    assign src0_q = '0;
-    assign dst0_q = '0;
+    // stand after this cycle's writes: = reg_blk(idn.src, a_d[0], b_d[0], c_d[0]), built
+    // as a forward, so that the late act_eff (wr0 = wpre && act_eff) picks between two
+    // values formed without it: the block as it stands, or the input block written now;
+    // a Refresh in stage 0 clears all three.
+    logic wpre, hit_s, hit_d, fw_s, fw_d;
+    logic [BlkW-1:0] base_s, base_d;
+    assign wpre   = (ev0 || st0) && !pv0 && (id0.dst != RegNone);
+    assign hit_s  = wpre && (idn.src == id0.dst);
+    assign hit_d  = wpre && (idn.dst == id0.dst);
+    assign fw_s   = z1 ? (hit_s && aez_q) : (hit_s && aenz_q);
+    assign fw_d   = z1 ? (hit_d && aez_q) : (hit_d && aenz_q);
+    assign base_s = reg_blk(idn.src, a_q[0], b_q[0], c_q[0]);
+    assign base_d = reg_blk(idn.dst, a_q[0], b_q[0], c_q[0]);
+    always_ff @(posedge clk_i) begin
+      if (hold_ab) begin
+        src0_q <= '0;
+        dst0_q <= '0;
+      end else begin
+        src0_q <= id0.refresh ? '0 : (fw_s ? in_blk[0] : base_s);
+        dst0_q <= id0.refresh ? '0 : (fw_d ? in_blk[0] : base_d);
+      end
+    end
   end else begin : g_no_in_regs
-    assign in_idsel_q = '0;
     assign in_id_q   = '0;
     assign in_data_q = '0;
     assign in_z1_q   = 1'b1;
