@@ -247,7 +247,9 @@ def chip(args) -> int:
         srcs = core_srcs("chip")
         # The iCE40 HX8K is full with 9 PEs: there the PE takes the small form of its
         # timing-only logic (de_pe Compact, same cycle behaviour; docs/fpga.md 6.3).
-        params = {"NumPe": npe, "Compact": COMPACT[fam]}
+        # The ECP5 chip registers each PE's input (de_chip InReg, docs/xproc.md 11); the
+        # Compact PE cannot (chip_top passes 0 for it; the bare de_chip needs it said).
+        params = {"NumPe": npe, "Compact": COMPACT[fam], "InReg": 1 - COMPACT[fam]}
         if nobyp:
             params["TieBypass"] = 1   # de_chip's what-if parameter: bypass_i 0, live_i 1
         cells_top = yosys(tmpl, out, "chip_top", srcs_top, params)
@@ -477,7 +479,7 @@ def seeds(args) -> int:
         trial = chip_trial_tag(args)
         print("[chip] synthesis of chip_top, 9 PEs", flush=True)
         yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"),
-              {"NumPe": 9, "Compact": COMPACT["ecp5"]})
+              {"NumPe": 9, "Compact": COMPACT["ecp5"], "InReg": 1})
         dev = ECP5["args"] + ["--freq", str(args.freq), "--lpf-allow-unconstrained",
                               *chip_pnr_args(args)]
         factor, floor = None, args.target_mhz

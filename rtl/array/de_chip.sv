@@ -6,7 +6,9 @@
 // The boundary registers keep the combinational depth independent of the chip count.
 // Because both buses gain exactly one register per chip, a pixel of column q leaves the
 // last chip at (Refresh entry) + q + NumChips + const for every q: raster order with no
-// gap and no collision (docs/array.md derives it).
+// gap and no collision (docs/array.md derives it). With InReg = 1 (each PE registers its
+// input: two bus clocks per PE position) the pixel chain has a register per PE instead,
+// two per bypassed PE, and column q leaves at entry + q + (NumPe + 1) NumChips + const.
 //
 // Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
 // PE's place is taken by a register on the bus and on the pixel chain (the source's
