@@ -303,16 +303,6 @@ module de_pe
     assign pass1   = z1 ? ((per1 && live) ? out_q[0] - BlkW'(1) : '0)
                         : in_blk[1] - BlkW'(dec1);
     assign blk1z_d = (out1 == '0);
-  end else if (InReg == 1) begin : g_pass1_in_reg
-    // As g_pass1_fast (the same kept nets), without the zero test for the next PE: it
-    // registers its own (in_z1_q) from its input, a cycle early.
-    (* keep *) logic seld1, selq1;
-    (* keep *) logic [BlkW-1:0] dm1;
-    assign seld1   = dec1 && !z1;
-    assign selq1   = z1 && per1 && live;
-    assign dm1     = in_blk[1] - BlkW'(1);
-    assign pass1   = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
-    assign blk1z_d = 1'b1;
   end else begin : g_pass1_fast
     // The decrement is a constant one (dm1) picked after the carry chain, so the chain
     // starts at the input block and not behind the decision: pass1 = z1 ? q1 : (dec1 ? dm1
@@ -324,7 +314,12 @@ module de_pe
     assign selq1 = z1 && per1 && live;
     assign dm1   = in_blk[1] - BlkW'(1);
     assign pass1 = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
+  end
 
+  if (Compact == 0 && InReg == 1) begin : g_z1_own
+    // The next PE registers its own zero test of block 1 from its input (in_z1_q).
+    assign blk1z_d = 1'b1;
+  end else if (Compact == 0) begin : g_z1_next
     // out1 == 0 for the next PE (blk1z_d), from the candidates rather than behind the out1
     // mux, so that the input block is three LUT levels from blk1z_q: the sums by
     // zero_terms (no carry chain) in kept groups of four bits; q1 = P - 1 = 0 when P = 1;
@@ -344,7 +339,7 @@ module de_pe
       assign zp_g[g] = &tp1[g*BlkW/3 +: BlkW/3];
     end
     assign zq1     = !(per1 && live) || (out_q[0] == BlkW'(1));
-    assign seln1   = sum1 ? !prot1_q : seld1;
+    assign seln1   = sum1 ? !prot1_q : g_pass1_fast.seld1;
     assign zrest   = sum1 ? (prot1_q && &zp_g) : (z1 && zq1);
     assign blk1z_d = seln1 ? &zn_g : zrest;
   end
