@@ -18,7 +18,10 @@ module chip_top #(
   parameter int unsigned NumPe    = 9,
   parameter int unsigned CarryBug = 0,
   parameter int unsigned Compact  = 0,   // de_pe Compact (1: the iCE40 chip, which is full)
-  parameter int unsigned TieBypass = 0   // de_chip TieBypass (1: flow.py's what-if chip)
+  parameter int unsigned TieBypass = 0,  // de_chip TieBypass (1: flow.py's what-if chip)
+  // de_chip InReg: 1 = each PE registers its input (docs/xproc.md section 11), the chip
+  // the ECP5 flow measures; the Compact (iCE40) chip always builds 0.
+  parameter int unsigned InReg    = 1
 ) (
   input  logic clk_i,
   input  logic rst_i,
@@ -95,7 +98,7 @@ module chip_top #(
   end
 
   de_chip #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .RstW(RstW),
-            .TieBypass(TieBypass)) u_chip (
+            .TieBypass(TieBypass), .InReg((Compact == 1) ? 0 : InReg)) u_chip (
     .clk_i,
     .rst_i      (rst_q),
     // id, data, pix_valid, pix from the shift register; de_chip does not use link_i.coll

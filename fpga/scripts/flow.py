@@ -87,9 +87,10 @@ ICE40 = [{"args": ["--up5k", "--package", "sg48"], "name": "iCE40UP5K SG48", "lc
 
 # nextpnr-ecp5's placer timing weight for the chip's runs (chip --family ecp5, seeds
 # --design chip, pe; --timing-weight overrides it): 10 is nextpnr's own default, which
-# then adds no option. The board flow (fpga/ulx3s) does not read this. The levers
-# measured over seeds: docs/fpga.md section 6.3; docs/fpga-timing-log.md sections 5-7.
-CHIP_TIMING_WEIGHT = 10
+# adds no option. 80 since the tenth look, chosen over seeds 1-5 against 10, 60 and 100
+# once the PE's input was registered (InReg): docs/fpga.md section 6.3,
+# docs/fpga-timing-log.md section 10. The board flow (fpga/ulx3s) does not read this.
+CHIP_TIMING_WEIGHT = 80
 
 
 def chip_pnr_args(args) -> list[str]:
@@ -111,7 +112,12 @@ def chip_trial_tag(args) -> str | None:
         parts.append("s" + args.seeds.replace(",", "-"))
     if args.freq != 200.0:
         parts.append(f"f{args.freq:g}")
-    parts += [re.sub(r"[^A-Za-z0-9.]+", "-", a).strip("-") for a in chip_pnr_args(args)]
+    # The timing weight only when it is not the committed one, then every --pnr-arg.
+    w = getattr(args, "timing_weight", CHIP_TIMING_WEIGHT)
+    if w != CHIP_TIMING_WEIGHT:
+        parts.append(f"placer-heap-timingweight_{w}")
+    for a in getattr(args, "pnr_arg", None) or []:
+        parts += [re.sub(r"[^A-Za-z0-9.]+", "-", b).strip("-") for b in a.split()]
     return "trial_" + "_".join(parts) if parts else None
 
 
@@ -241,7 +247,9 @@ def chip(args) -> int:
         srcs = core_srcs("chip")
         # The iCE40 HX8K is full with 9 PEs: there the PE takes the small form of its
         # timing-only logic (de_pe Compact, same cycle behaviour; docs/fpga.md 6.3).
-        params = {"NumPe": npe, "Compact": COMPACT[fam]}
+        # The ECP5 chip registers each PE's input (de_chip InReg, docs/xproc.md 11); the
+        # Compact PE cannot (chip_top passes 0 for it; the bare de_chip needs it said).
+        params = {"NumPe": npe, "Compact": COMPACT[fam], "InReg": 1 - COMPACT[fam]}
         if nobyp:
             params["TieBypass"] = 1   # de_chip's what-if parameter: bypass_i 0, live_i 1
         cells_top = yosys(tmpl, out, "chip_top", srcs_top, params)
@@ -471,7 +479,7 @@ def seeds(args) -> int:
         trial = chip_trial_tag(args)
         print("[chip] synthesis of chip_top, 9 PEs", flush=True)
         yosys("chip_ecp5.ys", out, "chip_top", core_srcs("fpga", "chip"),
-              {"NumPe": 9, "Compact": COMPACT["ecp5"]})
+              {"NumPe": 9, "Compact": COMPACT["ecp5"], "InReg": 1})
         dev = ECP5["args"] + ["--freq", str(args.freq), "--lpf-allow-unconstrained",
                               *chip_pnr_args(args)]
         factor, floor = None, args.target_mhz
@@ -585,8 +593,9 @@ def trial_options(args) -> str:
     opts = ""
     if args.freq != 200.0:
         opts += f" --freq {args.freq:g}"
-    if args.timing_weight != CHIP_TIMING_WEIGHT:
-        opts += f" --timing-weight {args.timing_weight}"
+    w = getattr(args, "timing_weight", CHIP_TIMING_WEIGHT)
+    if w != CHIP_TIMING_WEIGHT:
+        opts += f" --timing-weight {w}"
     return opts + "".join(f" --pnr-arg='{a}'" for a in (args.pnr_arg or []))
 
 

@@ -6,7 +6,8 @@
 //
 // Latency (docs/array.md): the pixel of column q of a Refresh that enters at cycle t
 // leaves at t + q + NumChips + PixLatency0, where q counts only PEs that are not
-// bypassed. Two Refreshes must be at least n_pe_o cycles apart (7.4.1: one Refresh
+// bypassed, plus one per bypassed PE; with InReg = 1 at t + q + (NumPe + 1) NumChips + 4
+// (each PE registers its input: two clocks per PE position on the bus). Two Refreshes must be at least n_pe_o cycles apart (7.4.1: one Refresh
 // active at a time); pix_collision_o flags a violation and stays set until reset.
 `default_nettype none
 
@@ -20,7 +21,10 @@ module de_array
   parameter logic [1023:0] FaultMask = '0,
   // de_chip TimingCopies: 0 leaves out the timing-only register copies (the Verilated
   // harnesses, sim/Makefile); no output changes.
-  parameter int unsigned TimingCopies = 1
+  parameter int unsigned TimingCopies = 1,
+  // de_chip InReg: 1 = every PE registers its input (the chip of the FPGA flow, which
+  // closes faster; docs/array.md, "Pixel timing"); 0 = one clock per PE position.
+  parameter int unsigned InReg = 0
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
@@ -82,7 +86,8 @@ module de_array
       .NumPe    (NumPe),
       .CarryBug (CarryBug),
       .FaultMask(32'(FaultMask[c*NumPe +: NumPe])),
-      .TimingCopies(TimingCopies)
+      .TimingCopies(TimingCopies),
+      .InReg    (InReg)
     ) u_chip (
       .clk_i, .rst_i,
       .link_i     (link_c[c]),

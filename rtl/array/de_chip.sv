@@ -6,7 +6,9 @@
 // The boundary registers keep the combinational depth independent of the chip count.
 // Because both buses gain exactly one register per chip, a pixel of column q leaves the
 // last chip at (Refresh entry) + q + NumChips + const for every q: raster order with no
-// gap and no collision (docs/array.md derives it).
+// gap and no collision (docs/array.md derives it). With InReg = 1 (each PE registers its
+// input: two bus clocks per PE position) the pixel chain has a register per PE instead,
+// two per bypassed PE, and column q leaves at entry + q + (NumPe + 1) NumChips + const.
 //
 // Configuration (7.4.5): a serial shift register with one bypass bit per PE. A bypassed
 // PE's place is taken by a register on the bus and on the pixel chain (the source's
@@ -37,7 +39,12 @@ module de_chip
   // bypass_i tied to 0 and live_i to 1, so synthesis sees the static configuration as
   // the constant it is in use (what the bypass costs, which STA cannot know is static).
   // The configuration chain still shifts but bypasses no PE. 0 in every product.
-  parameter int unsigned TieBypass = 0
+  parameter int unsigned TieBypass = 0,
+  // 1 = every PE registers its own input (de_pe InReg: two clocks per PE position on the
+  // bus) and the pixel chain has one register per PE, two per bypassed PE, so that the
+  // pixels still leave one per clock in raster order (docs/array.md); 0 = one clock per
+  // PE position and a combinational pixel chain inside the chip.
+  parameter int unsigned InReg = 0
 ) (
   input  logic             clk_i,
   // Synchronous, active high: RstW registered copies of ONE reset, equal in every cycle.
@@ -82,13 +89,14 @@ module de_chip
   link_t core_link;
 
   de_chip_core #(.NumPe(NumPe), .CarryBug(CarryBug), .Compact(Compact), .FaultMask(FaultMask),
-                 .RstW(RstW), .TimingCopies(TimingCopies), .TieBypass(TieBypass))
+                 .RstW(RstW), .TimingCopies(TimingCopies), .TieBypass(TieBypass),
+                 .InReg(InReg))
   u_core (
     .clk_i, .rst_i, .link_i, .blk1z_i, .idsel_i, .chain_ctl_i, .chain_i, .chain_o,
     .bypass_o, .link_o(core_link)
   );
 
-  de_chip_bound #(.IdCopy((Compact == 0 && TimingCopies == 1) ? 1 : 0)) u_bound (
+  de_chip_bound #(.IdCopy((Compact == 0 && TimingCopies == 1 && InReg == 0) ? 1 : 0)) u_bound (
     .clk_i, .rst_i(rst_i[(5 * NumPe + 1) % RstW]), .link_i(core_link), .link_o, .blk1z_o,
     .idsel_o
   );
@@ -108,7 +116,8 @@ module de_chip_core
   parameter logic [31:0] FaultMask = '0,
   parameter int unsigned RstW      = 1,   // copies of the reset (de_chip)
   parameter int unsigned TimingCopies = 1,  // de_chip
-  parameter int unsigned TieBypass = 0      // de_chip (what-if only)
+  parameter int unsigned TieBypass = 0,     // de_chip (what-if only)
+  parameter int unsigned InReg     = 0      // de_chip
 ) (
   input  logic             clk_i,
   /* verilator lint_off UNUSEDSIGNAL */
@@ -157,7 +166,13 @@ module de_chip_core
   logic [NumPe:0]            pixv_or;
   logic [NumPe-1:0][PixW-1:0] src_pix;  // what PE i puts on the pixel chain
   logic [NumPe-1:0]           src_pixv;
-  logic [NumPe-1:0]          coll;
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [NumPe-1:0][PixW-1:0] pe_pix_all;  // PE i's pixel register (InReg = 1's chain)
+  logic [NumPe-1:0]           pe_pixv_all; // its valid bit (the copy, pe_pixvc)
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [NumPe-1:0]          coll;     // (InReg = 1: the collision travels on the chain)
+  /* verilator lint_on UNUSEDSIGNAL */
   logic [NumPe-1:0]          byp_d, byp_q;
   logic [NumPe-1:0][PeRstW-1:0] pe_byp;    // de_pe bypass_i (equal copies)
   logic [NumPe-1:0]          pe_live;          // de_pe live_i
@@ -193,7 +208,8 @@ module de_chip_core
 
     logic [IdW-1:0]   pe_idsel;
     de_pe #(.CarryBug(CarryBug), .Compact(Compact), .RstW(PeRstW),
-            .IdCopy((Compact == 0 && TimingCopies == 1) ? 1 : 0),
+            .IdCopy((Compact == 0 && TimingCopies == 1 && InReg == 0) ? 1 : 0),
+            .InReg(InReg),
             .PixCopy((Compact == 0 && TimingCopies == 1) ? 1 : 0)) u_pe (
       .clk_i,
       .rst_i      (pe_rst[i]),
@@ -241,6 +257,8 @@ module de_chip_core
     // The pixel chain at PE i (below): a bypassed PE's register replaces everything in
     // front of it, a PE in use adds its pixel. At most one PE of the whole array drives a
     // pixel in a cycle, so OR is a mux.
+    assign pe_pix_all[i]  = pe_pix;
+    assign pe_pixv_all[i] = pe_pixvc;
     assign src_pix[i]  = byp_q[i] ? byp_pix_q  : (pe_pixv ? pe_pix : '0);
     assign src_pixv[i] = byp_q[i] ? byp_pixv_q : pe_pixvc;
     assign coll[i]     = pixv_or[i] && pe_pixvc && !byp_q[i];
@@ -358,7 +376,37 @@ module de_chip_core
     end
   end
 
-  assign link_o = {bus_id[NumPe], bus_data[NumPe], pixv_or[NumPe], pix_or[NumPe], |coll};
+  if (InReg == 0) begin : g_link_or
+    assign link_o = {bus_id[NumPe], bus_data[NumPe], pixv_or[NumPe], pix_or[NumPe], |coll};
+  end else begin : g_link_chain
+    // One register per PE on the pixel chain, two per bypassed PE: the bus costs two
+    // clocks per PE position, so each used column's pixel follows the one before it by
+    // exactly one clock, and a bypassed position delays what is upstream by its two.
+    logic [NumPe:0][PixW-1:0] cp;
+    logic [NumPe:0]           cv, cc;
+    assign cp[0] = link_i.pix_valid ? link_i.pix : '0;
+    assign cv[0] = link_i.pix_valid;
+    assign cc[0] = 1'b0;
+    for (genvar i = 0; i < NumPe; i++) begin : g_chain
+      logic [PixW-1:0] a_pix_q, b_pix_q;
+      logic            a_pixv_q, b_pixv_q, a_coll_q, b_coll_q;
+      always_ff @(posedge clk_i) begin
+        if (rst_loc[i]) begin
+          {a_pix_q, a_pixv_q, a_coll_q} <= '0;
+          {b_pix_q, b_pixv_q, b_coll_q} <= '0;
+        end else begin
+          a_pix_q  <= cp[i] | pe_pix_all[i];
+          a_pixv_q <= cv[i] | pe_pixv_all[i];
+          a_coll_q <= cc[i] | (cv[i] && pe_pixv_all[i]);
+          {b_pix_q, b_pixv_q, b_coll_q} <= {a_pix_q, a_pixv_q, a_coll_q};
+        end
+      end
+      assign cp[i+1] = byp_q[i] ? b_pix_q  : a_pix_q;
+      assign cv[i+1] = byp_q[i] ? b_pixv_q : a_pixv_q;
+      assign cc[i+1] = byp_q[i] ? b_coll_q : a_coll_q;
+    end
+    assign link_o = {bus_id[NumPe], bus_data[NumPe], cv[NumPe], cp[NumPe], cc[NumPe]};
+  end
 
 endmodule
 

@@ -36,9 +36,14 @@ module display_controller #(
   // log2 of the span array's pixel -> core FIFO (slots); 8 keeps the tested default, the
   // board takes 11 because the CAD scene's paced backlog reaches 698 slots (docs/board-frames.md)
   parameter int unsigned SpanFifoAw  = 8,
+  // de_array InReg (SpanArray = 0): 1 = the arrays of the chip the FPGA flow builds, each
+  // PE with its input registered; the same pixels, later (ArrayLatency).
+  parameter int unsigned InReg       = 0,
   // docs/array.md: a Refresh on id_i in the cycle ending with edge E puts column q on
-  // pix_o right after edge E + NumChips + 2 + q, i.e. NumChips + 3 cycles later.
-  localparam int unsigned ArrayLatency = SpanArray != 0 ? SpanLatency : NumChips + 3,
+  // pix_o right after edge E + NumChips + 2 + q, i.e. NumChips + 3 cycles later; with
+  // InReg, (NumPe + 1) NumChips + 4 cycles later (NumPe = 9).
+  localparam int unsigned ArrayLatency = SpanArray != 0 ? SpanLatency
+                                       : (InReg != 0 ? 10 * NumChips + 4 : NumChips + 3),
   localparam int unsigned NumCh        = 3
 ) (
   input  logic                                 clk_i,
@@ -159,7 +164,8 @@ module display_controller #(
 
     de_array #(
       .NumChips(NumChips),
-      .CarryBug(CarryBug)
+      .CarryBug(CarryBug),
+      .InReg   (InReg)
     ) u_array (
       .clk_i,
       .rst_i,

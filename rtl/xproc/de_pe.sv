@@ -32,7 +32,14 @@ module de_pe
   parameter int unsigned IdCopy = 0,
   // Timing only: 1 = pixv_c_o is a register of its own (a copy of the pixel-valid register
   // for the chip's collision flag and valid chain); 0 = pixv_c_o is pix_valid_o.
-  parameter int unsigned PixCopy = 0
+  parameter int unsigned PixCopy = 0,
+  // 1 = the PE registers its own input (id_i, data_i) before stage 0 and computes beside
+  // that register, a cycle early, what stage 0 would otherwise compute behind it: block
+  // 1's zero test, X - 1 and stage 0's SRC and DST operands (docs/xproc.md section 9).
+  // The PE then costs two clocks on the bus instead of one; its registers hold the same
+  // values for the same slots, one clock later. blk1z_i and idsel_i are not read and
+  // blk1z_o is constant (the next PE tests its own input). 0 when Compact.
+  parameter int unsigned InReg = 0
 ) (
   input  logic             clk_i,
   // Synchronous, active high. RstW copies of ONE reset, equal in every cycle (registered
@@ -79,6 +86,9 @@ module de_pe
   end
   if (RstW < 1 || RstW > 4) begin : g_bad_rst_w
     $fatal(1, "de_pe: RstW must be 1..4, got %0d", RstW);
+  end
+  if (InReg > 1 || (InReg == 1 && Compact == 1)) begin : g_bad_in_reg
+    $fatal(1, "de_pe: InReg must be 0 or 1 (0 when Compact), got %0d", InReg);
   end
   if (AddCarryBlk == 1) begin : g_bad_carry_blk
     // blk1z_d's zero test of a block-1 sum takes the carry into bit 0 (zero_terms).
@@ -144,8 +154,22 @@ module de_pe
   /* verilator lint_off UNUSEDSIGNAL */
   id_t id1, id2;
   /* verilator lint_on UNUSEDSIGNAL */
-  assign in_blk = data_i;
-  assign id0 = id_t'(id_i);
+  // InReg: the input register (in_id_q, in_data_q) and, beside it, what stage 0 needs,
+  // computed from the unregistered input a cycle early (registers g_in_regs, below).
+  logic [IdW-1:0]   in_id_q;
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [DataW-1:0] in_data_q;       // (InReg = 0: unused)
+  /* verilator lint_on UNUSEDSIGNAL */
+  logic             in_z1_q;         // block 1 of in_data_q is zero (blk1z_i's job)
+  logic [BlkW:0]    in_dm0_q;        // {carry, X - 1} of block 0 of in_data_q
+  logic [BlkW-1:0]  src0_q, dst0_q;  // stage 0's SRC and DST blocks
+  if (InReg == 1) begin : g_in_reg
+    assign in_blk = in_data_q;
+    assign id0    = id_t'(in_id_q);
+  end else begin : g_in_wire
+    assign in_blk = data_i;
+    assign id0    = id_t'(id_i);
+  end
   assign id1 = id_t'(id_q);
   assign id2 = id_t'(id2_q);
 
@@ -160,7 +184,7 @@ module de_pe
   // The zero test of block 1 is made by the sender, from its own candidates for the
   // block, and arrives on a flip-flop beside the block (blk1z_i; blk1z_d below). A
   // Compact PE tests the block itself and leaves the flag unused (fewer cells).
-  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : blk1z_i;
+  assign z1        = (Compact == 1) ? (in_blk[1] == '0) : (InReg == 1) ? in_z1_q : blk1z_i;
   // = id1.addr && (id1.sub == SubPeriodic), registered beside id_q (per1_q; not Compact).
   assign per1      = (Compact == 1) ? (id1.addr && (id1.sub == SubPeriodic)) : per1_q;
   // The slot at stage 0 one cycle behind an address slot belongs to its command, so it
@@ -171,7 +195,10 @@ module de_pe
   assign act_eff   = z1 ? aez_q : aenz_q;
 
   // ---- stage 0: identifier + block 0 ---------------------------------------------------
-  logic ev0, st0, rng0, xz0, pv0, prot0, active0, wr0;
+  logic ev0, st0, rng0, xz0, pv0, prot0, wr0;
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic active0;  // (InReg = 1: sum0 is formed from its two halves)
+  /* verilator lint_on UNUSEDSIGNAL */
   logic [BlkW-1:0] src0, out0;
   logic [BlkW:0] sp0, sn0, s0;
   assign ev0     = id0.data && !id0.set;
@@ -179,8 +206,9 @@ module de_pe
   assign rng0    = id0.addr && (id0.sub != SubPeriodic);
   // X - 1 as a constant decrement with its carry out: the carry is 1 unless X is 0, so the
   // zero test of X comes out of the same carry chain, not from two LUT levels of its own.
+  // InReg: computed a cycle early (in_dm0_q).
   (* keep *) logic [BlkW:0] dm0;
-  assign dm0     = {1'b0, in_blk[0]} + {1'b0, {BlkW{1'b1}}};
+  assign dm0     = (InReg == 1) ? in_dm0_q : {1'b0, in_blk[0]} + {1'b0, {BlkW{1'b1}}};
   assign xz0     = !dm0[BlkW];
   // Protection is decided once per slot, here, and travels with it down the pipeline;
   // pv0 is the part that does not depend on act_eff.
@@ -192,10 +220,14 @@ module de_pe
   id_t id0s;
   /* verilator lint_on UNUSEDSIGNAL */
   assign id0s    = (IdCopy == 1) ? id_t'(idsel_i) : id0;
-  assign src0    = reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
+  // InReg: both operands come from registers (src0_q, dst0_q), so the adders start at
+  // flip-flops rather than behind the identifier's decode.
+  logic [BlkW-1:0] dst0;
+  assign src0    = (InReg == 1) ? src0_q : reg_blk(id0s.src, a_q[0], b_q[0], c_q[0]);
+  assign dst0    = (InReg == 1) ? dst0_q : reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0]);
   // v0 + SRC0 with v0 = prot0 ? DST0 : in0: both sums are formed while act_eff is still
   // being decided and pv0 picks one after the adders (carry select on the operand).
-  assign sp0     = {1'b0, reg_blk(id0s.dst, a_q[0], b_q[0], c_q[0])} + {1'b0, src0};
+  assign sp0     = {1'b0, dst0} + {1'b0, src0};
   assign sn0     = {1'b0, in_blk[0]} + {1'b0, src0};
   assign s0      = pv0 ? sp0 : sn0;
   // A protected slot writes DST with DST's own value: no write. So a write is in0 only.
@@ -211,9 +243,21 @@ module de_pe
   // sn0, pass0 (one PFUMX) rather than a 7-input function of the decisions.
   // Relative addressing counts X down to 0 and keeps it there: pass0 picks X, X - 1 or 0
   // after the decrement (a LUT4 of rng0l, the carry, the two bits).
-  (* keep *) logic sum0, rng0l;
+  (* keep *) logic rng0l;
   (* keep *) logic [BlkW-1:0] pass0;
-  assign sum0  = active0 && live;
+  logic sum0;
+  if (InReg == 1) begin : g_sum0_split
+    // sum0 for both outcomes of the zero test (kept nets), so that z1 picks one inside
+    // the out0 logic itself: one routed hop from the zero test to out_q[0].
+    (* keep *) logic sum0z, sum0nz;
+    assign sum0z  = ev0 && aez_q && live;
+    assign sum0nz = ev0 && aenz_q && live;
+    assign sum0   = z1 ? sum0z : sum0nz;
+  end else begin : g_sum0
+    (* keep *) logic sum0_k;
+    assign sum0_k = active0 && live;
+    assign sum0   = sum0_k;
+  end
   assign rng0l = rng0 && live;
   assign pass0 = rng0l ? (xz0 ? '0 : dm0[BlkW-1:0]) : in_blk[0];
   assign out0 = sum0 ? s0[BlkW-1:0] : pass0;
@@ -270,7 +314,12 @@ module de_pe
     assign selq1 = z1 && per1 && live;
     assign dm1   = in_blk[1] - BlkW'(1);
     assign pass1 = seld1 ? dm1 : (selq1 ? out_q[0] - BlkW'(1) : in_blk[1]);
+  end
 
+  if (Compact == 0 && InReg == 1) begin : g_z1_own
+    // The next PE registers its own zero test of block 1 from its input (in_z1_q).
+    assign blk1z_d = 1'b1;
+  end else if (Compact == 0) begin : g_z1_next
     // out1 == 0 for the next PE (blk1z_d), from the candidates rather than behind the out1
     // mux, so that the input block is three LUT levels from blk1z_q: the sums by
     // zero_terms (no carry chain) in kept groups of four bits; q1 = P - 1 = 0 when P = 1;
@@ -290,7 +339,7 @@ module de_pe
       assign zp_g[g] = &tp1[g*BlkW/3 +: BlkW/3];
     end
     assign zq1     = !(per1 && live) || (out_q[0] == BlkW'(1));
-    assign seln1   = sum1 ? !prot1_q : seld1;
+    assign seln1   = sum1 ? !prot1_q : g_pass1_fast.seld1;
     assign zrest   = sum1 ? (prot1_q && &zp_g) : (z1 && zq1);
     assign blk1z_d = seln1 ? &zn_g : zrest;
   end
@@ -480,13 +529,14 @@ module de_pe
     assign wr2   = wr2_q;
   end
   // (Compact: plain, blk1z_d does not use src1.)
-  assign src1_d = (sum0 || Compact == 1) ? reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
+  assign src1_d = (sum0 || Compact == 1 || InReg == 1) ?
+                  reg_blk(id0.src, a_d[1], b_d[1], c_d[1]) : '1;
   assign dst1_d = reg_blk(id0.dst, a_d[1], b_d[1], c_d[1]);
   assign src2_d = reg_blk(id1.src, a_d[2], b_d[2], c_d[2]);
   assign dst2_d = reg_blk(id1.dst, a_d[2], b_d[2], c_d[2]);
 
   // ---- pipeline next state ----------------------------------------------------------------
-  assign id_d     = id_i;
+  assign id_d     = (InReg == 1) ? in_id_q : id_i;
   assign out_d    = {out2, out1, out0};
   assign id2_d    = id_q;
   assign xz1_d    = rng0 && xz0;
@@ -541,6 +591,60 @@ module de_pe
       per1_q  <= per1_d;
       src1_q  <= src1_d;
     end
+  end
+
+  // InReg: the input register follows the bus (a bypassed PE passes its input through it,
+  // so it costs two clocks like a PE in use), the operand registers follow the register
+  // blocks (zero in reset and in bypass, as the blocks are).
+  if (InReg == 1) begin : g_in_regs
+    // Only the register fields of the next slot's identifier are read here.
+    /* verilator lint_off UNUSEDSIGNAL */
+    id_t idn;
+    /* verilator lint_on UNUSEDSIGNAL */
+    assign idn = id_t'(id_i);
+    always_ff @(posedge clk_i) begin
+      if (rst_bus) begin
+        in_id_q   <= '0;
+        in_data_q <= '0;
+        in_z1_q   <= 1'b1;
+        in_dm0_q  <= {1'b0, {BlkW{1'b1}}};
+      end else begin
+        in_id_q   <= id_i;
+        in_data_q <= data_i;
+        in_z1_q   <= (data_i[BlkW +: BlkW] == '0);
+        in_dm0_q  <= {1'b0, data_i[0 +: BlkW]} + {1'b0, {BlkW{1'b1}}};
+      end
+    end
+    // The slot on id_i now is in stage 0 next cycle and reads the register blocks as they
+    // stand after this cycle's writes: = reg_blk(idn.src, a_d[0], b_d[0], c_d[0]), built
+    // as a forward, so that the late act_eff (wr0 = wpre && act_eff) picks between two
+    // values formed without it: the block as it stands, or the input block written now;
+    // a Refresh in stage 0 clears all three.
+    logic wpre, hit_s, hit_d, fw_s, fw_d;
+    logic [BlkW-1:0] base_s, base_d;
+    assign wpre   = (ev0 || st0) && !pv0 && (id0.dst != RegNone);
+    assign hit_s  = wpre && (idn.src == id0.dst);
+    assign hit_d  = wpre && (idn.dst == id0.dst);
+    assign fw_s   = z1 ? (hit_s && aez_q) : (hit_s && aenz_q);
+    assign fw_d   = z1 ? (hit_d && aez_q) : (hit_d && aenz_q);
+    assign base_s = reg_blk(idn.src, a_q[0], b_q[0], c_q[0]);
+    assign base_d = reg_blk(idn.dst, a_q[0], b_q[0], c_q[0]);
+    always_ff @(posedge clk_i) begin
+      if (hold_ab) begin
+        src0_q <= '0;
+        dst0_q <= '0;
+      end else begin
+        src0_q <= id0.refresh ? '0 : (fw_s ? in_blk[0] : base_s);
+        dst0_q <= id0.refresh ? '0 : (fw_d ? in_blk[0] : base_d);
+      end
+    end
+  end else begin : g_no_in_regs
+    assign in_id_q   = '0;
+    assign in_data_q = '0;
+    assign in_z1_q   = 1'b1;
+    assign in_dm0_q  = '0;
+    assign src0_q    = '0;
+    assign dst0_q    = '0;
   end
 
   // Everything else; a bypassed PE holds it in reset (no pixel, an all-zero state).

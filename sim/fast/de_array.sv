@@ -16,7 +16,9 @@ module de_array
   parameter int unsigned NumPe     = 9,
   parameter logic [1023:0] FaultMask = '0,
   // The pieces are built without the timing-only copies (de_chip TimingCopies = 0).
-  parameter int unsigned TimingCopies = 0
+  parameter int unsigned TimingCopies = 0,
+  // de_chip InReg: the composed model has one clock per PE position (InReg = 0) only.
+  parameter int unsigned InReg = 0
 ) (
   input  logic             clk_i,
   input  logic             rst_i,
@@ -45,6 +47,9 @@ module de_array
 
   if (FaultMask != '0) begin : g_bad_fault_mask
     $fatal(1, "de_array (sim/fast): FaultMask is a test of the flat RTL only");
+  end
+  if (InReg != 0) begin : g_bad_in_reg
+    $fatal(1, "de_array (sim/fast): InReg = 1 is built from the flat RTL only");
   end
 
   chandle h;

@@ -24,14 +24,24 @@ def flow():
 
 
 def chip_args(**kw):
-    base = dict(design="chip", seeds="1,2,3,4,5", freq=200.0, timing_weight=10, pnr_arg=None)
+    # No timing_weight: the flow's own default (CHIP_TIMING_WEIGHT), as argparse gives it.
+    base = dict(design="chip", seeds="1,2,3,4,5", freq=200.0, pnr_arg=None)
     base.update(kw)
     return argparse.Namespace(**base)
 
 
 def test_the_committed_configuration_is_not_a_trial(flow):
     assert flow.chip_trial_tag(chip_args()) is None
-    assert flow.chip_pnr_args(chip_args()) == []
+    assert flow.chip_trial_tag(chip_args(timing_weight=flow.CHIP_TIMING_WEIGHT)) is None
+    assert flow.chip_pnr_args(chip_args()) == ["--placer-heap-timingweight",
+                                               str(flow.CHIP_TIMING_WEIGHT)]
+
+
+def test_nextpnrs_own_default_weight_is_a_trial_now(flow):
+    # 10 adds no nextpnr option, but it is not the committed weight (80): a trial.
+    assert flow.CHIP_TIMING_WEIGHT != 10
+    assert flow.chip_pnr_args(chip_args(timing_weight=10)) == []
+    assert flow.chip_trial_tag(chip_args(timing_weight=10)) == "trial_placer-heap-timingweight_10"
 
 
 @pytest.mark.parametrize("kw, tag", [

@@ -28,6 +28,21 @@ from diffengine.model import structural as st
 
 NUM_PE = 9
 FAULTY = (3, 10)  # PEs garbled by the FaultMask build (bypass test)
+# de_array InReg: every PE registers its input (two clocks per PE position on the bus).
+IN_REG = int(os.environ.get("DE_IN_REG", "0"))
+
+
+def state_lag(q: int) -> int:
+    """Cycles by which PE q sees the stream after the structural model's PE q (one
+    register per PE): one per chip boundary before it; with InReg also its own input
+    register and one more per PE before it (docs/array.md, "Pixel timing")."""
+    return q // NUM_PE + (1 + q if IN_REG else 0)
+
+
+def pixel_latency(k: int) -> int:
+    """Rising edges from the one that clocks a Refresh in to the one after which column 0
+    is on pix_o, for k chips and no PE bypassed (docs/array.md)."""
+    return (NUM_PE + 1) * k + 3 if IN_REG else k + 2
 
 
 def chips(dut) -> int:
@@ -107,7 +122,7 @@ class Array:
     def compare_state(self):
         t = len(self.history) - 1
         for q in range(self.n):
-            lag = q // NUM_PE  # one boundary register per chip
+            lag = state_lag(q)
             if t - lag < 0:
                 continue
             want = self.history[t - lag][q]
@@ -172,12 +187,12 @@ async def directed_boundaries(dut):
     want = functional.render(cmds, n, carry_bug=carry_bug(dut))
     np.testing.assert_array_equal(arr.frame(), want)
     # docs/array.md: a Refresh on id_i in the cycle ending with edge R puts column q
-    # on pix_o after edge R + NumChips + 2 + q.
-    k = arr.k
+    # on pix_o after edge R + NumChips + 2 + q (InReg: R + 10 NumChips + 3 + q).
+    want_lat = pixel_latency(arr.k)
     for line, r in enumerate(arr.refresh_edges):
         edges = arr.pixel_edges[line * n:(line + 1) * n]
         assert edges == list(range(edges[0], edges[0] + n)), f"line {line}: gaps {edges}"
-        assert edges[0] - r == k + 2, f"line {line}: latency {edges[0] - r}, want {k + 2}"
+        assert edges[0] - r == want_lat, f"line {line}: latency {edges[0] - r}, want {want_lat}"
 
 
 @cocotb.test()
@@ -225,8 +240,7 @@ async def observation_chain(dut):
     pos = dict(zip([n for n, _ in st.DBG_FIELDS], _field_pos()))
     t = len(arr.history) - 1
     for word, q in zip(words, order):
-        lag = q // NUM_PE
-        dbg = arr.history[t - lag][q]
+        dbg = arr.history[t - state_lag(q)][q]
         f = lambda name: (dbg >> pos[name][0]) & ((1 << pos[name][1]) - 1)  # noqa: E731
         flags = 0
         for name in flag_names:
@@ -257,7 +271,8 @@ async def table_7_5_through_the_mapper(dut):
     cmd = isa.Command("EVAL", 0, 9, (0, 0, 1 << 23))  # ddI = 0x000.800000
     words = binfmt.framestore_encode([cmd], window=0)
     slots = [binfmt.map_word(w, 0, compensate=bug) for w in words]
-    await arr.play(slots + [(0, 0)] * 16)  # the last PE sees the slots 8+2 cycles later
+    # The last PE sees the slots 8+2 cycles later (InReg: 8+1+8+2).
+    await arr.play(slots + [(0, 0)] * (16 + 9 * IN_REG))
     want_di, want_i = TABLE_7_5_COMPENSATED if bug else (
         ["000.000000", "000.800000", "001.000000", "001.800000", "002.000000",
          "002.800000", "003.000000", "003.800000", "004.000000"],
@@ -289,7 +304,7 @@ async def bypass_equals_smaller_array(dut):
     np.testing.assert_array_equal(got, functional.render(cmds, width, carry_bug=carry_bug(dut)))
     # The bypass is registered (docs/array.md): the pixels of a line still leave without
     # a gap, one clock later per bypassed PE than from an array without bypass.
-    want_lat = arr.k + 2 + len(bypass)
+    want_lat = pixel_latency(arr.k) + len(bypass)
     for line, r in enumerate(arr.refresh_edges):
         edges = arr.pixel_edges[line * width:(line + 1) * width]
         assert edges == list(range(edges[0], edges[0] + width)), f"line {line}: gaps {edges}"
@@ -300,14 +315,17 @@ async def bypass_equals_smaller_array(dut):
 
 # ---- pytest runners: one build folder per parameter set --------------------------------
 
-RUNS = [  # (chips, carry_bug, faulty)
-    (1, 0, 0), (2, 0, 0), (2, 1, 0), (2, 0, 1),
+RUNS = [  # (chips, carry_bug, faulty, in_reg)
+    (1, 0, 0, 0), (2, 0, 0, 0), (2, 1, 0, 0), (2, 0, 1, 0),
+    # InReg: the chip the FPGA flow builds (each PE's input registered).
+    (2, 0, 0, 1), (2, 1, 1, 1),
 ]
 
 
-@pytest.mark.parametrize("chips,bug,faulty", RUNS,
-                         ids=[f"chips{c}_bug{b}_faulty{f}" for c, b, f in RUNS])
-def test_de_array(chips, bug, faulty):
+@pytest.mark.parametrize("chips,bug,faulty,in_reg", RUNS,
+                         ids=[f"chips{c}_bug{b}_faulty{f}" + ("_inreg" if r else "")
+                              for c, b, f, r in RUNS])
+def test_de_array(chips, bug, faulty, in_reg):
     from common.run import build_and_test, rtl_files
     here = Path(__file__).resolve().parent
     srcs = rtl_files("array", "sim")
@@ -315,6 +333,9 @@ def test_de_array(chips, bug, faulty):
     params = {"NumChips": chips, "CarryBug": bug}
     if faulty:
         params["FaultMask"] = mask
+    if in_reg:
+        params["InReg"] = 1
     build_and_test(here, "de_array", srcs, "test_de_array", parameters=params,
-                   extra_env={"DE_CARRY_BUG": str(bug), "DE_FAULTY": str(faulty)},
+                   extra_env={"DE_CARRY_BUG": str(bug), "DE_FAULTY": str(faulty),
+                              "DE_IN_REG": str(in_reg)},
                    testcase="bypass_equals_smaller_array" if faulty else None)

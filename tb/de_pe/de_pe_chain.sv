@@ -11,7 +11,8 @@ module de_pe_chain
   parameter int unsigned CarryBug = 0,
   // de_pe Compact (1: the iCE40 form); the fast form (0) also takes the identifier copy
   // (de_pe IdCopy = 1, idsel_i/idsel_o chained as in de_chip).
-  parameter int unsigned Compact  = 0
+  parameter int unsigned Compact  = 0,
+  parameter int unsigned InReg    = 0   // de_pe InReg: each PE registers its input
 ) (
   input  logic               clk_i,
   input  logic               rst_i,
@@ -64,7 +65,8 @@ module de_pe_chain
     de_pe #(
       .CarryBug(CarryBug),
       .Compact (Compact),
-      .IdCopy  ((Compact == 1) ? 0 : 1)
+      .IdCopy  ((Compact == 1 || InReg == 1) ? 0 : 1),
+      .InReg   (InReg)
     ) u_pe (
       .clk_i,
       .rst_i,

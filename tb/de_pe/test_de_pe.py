@@ -43,6 +43,10 @@ except ImportError:  # pragma: no cover
 
 N_PE = int(os.environ.get("DE_N_PE", "9"))
 CARRY_BUG = int(os.environ.get("DE_CARRY_BUG", "0"))
+# de_pe InReg: each PE registers its input, so PE p sees the stream p + 1 clocks after the
+# model's PE p (which has one register per PE); its state is compared with the model's
+# history that many cycles back.
+IN_REG = int(os.environ.get("DE_IN_REG", "0"))
 FIX = 1 << isa.FRAC_BITS  # 1.0 in 12.24
 
 
@@ -103,31 +107,50 @@ class Checker:
         self.slots = 0
         self.pixels: list[list[int]] = [[] for _ in range(n_pe)]
         self.error: str | None = None
+        # How many cycles PE p lags the model, and the model's snapshots, newest last:
+        # (packed state, pixel valid, pixel) per PE after each step.
+        self.lag = [(p + 1) * IN_REG for p in range(n_pe)]
+        self.history: list[tuple] = []
+
+    def snapshot(self) -> tuple:
+        s = self.model.state()
+        return (self.model.packed_state(), [int(v) for v in s["pix_valid"]],
+                [int(v) for v in s["pix"]])
+
+    def lagged(self, p: int) -> tuple[int, int, int]:
+        """The model's PE p as the RTL's PE p should show it now (its lag back)."""
+        words, valid, pix = self.history[max(0, len(self.history) - 1 - self.lag[p])]
+        return words[p], valid[p], pix[p]
 
     def expected_dbg(self) -> int:
         v = 0
-        for p, word in enumerate(self.model.packed_state()):
-            v |= word << (p * st.DBG_WIDTH)
+        for p in range(self.n):
+            v |= self.lagged(p)[0] << (p * st.DBG_WIDTH)
         return v
 
     def sample(self, rst, ident, data, dbg, pix_valid, pix) -> None:
         if self.error:
             return
         if rst:
+            # A synchronous reset clears every PE in the same cycle, whatever its lag:
+            # each lagging PE then sees only Nops (which keep the reset state) until the
+            # stream reaches it, so its view of the past is the reset state too.
             self.model.reset()
+            self.history = [self.snapshot()] * (len(self.history) + 1)
         else:
             self.model.step(ident, data)
             self.slots += ident != isa.NOP
+            self.history.append(self.snapshot())
         self.cycles += 1
         exp = self.expected_dbg()
         if dbg != exp:
             self.error = self.describe(dbg, exp, ident)
             return
-        s = self.model.state()
         for p in range(self.n):
             v = (pix_valid >> p) & 1
             px = (pix >> (p * 12)) & 0xFFF
-            if v != int(s["pix_valid"][p]) or px != int(s["pix"][p]):
+            _, want_v, want_px = self.lagged(p)
+            if v != want_v or px != want_px:
                 self.error = f"cycle {self.model.cycle}: pixel port of PE {p} {v}/{px:#x}"
                 return
             if v:
@@ -172,7 +195,7 @@ class Env:
         while self.driver.queue:
             await FallingEdge(self.dut.clk_i)
             self.check()
-        for _ in range(tail if tail is not None else N_PE + 4):
+        for _ in range(tail if tail is not None else N_PE * (1 + IN_REG) + 4):
             await FallingEdge(self.dut.clk_i)
             self.check()
 
@@ -409,12 +432,12 @@ def _sources() -> list[Path]:
     return rtl_files("diffengine:tb:de_pe")
 
 
-def _run(carry_bug: int, n_pe: int = 9, compact: int = 0) -> None:
+def _run(carry_bug: int, n_pe: int = 9, compact: int = 0, in_reg: int = 0) -> None:
     from cocotb_tools.runner import get_runner
 
     runner = get_runner("verilator")
-    params = {"N": n_pe, "CarryBug": carry_bug, "Compact": compact}
-    build_dir = TB_DIR / f"sim_build_N{n_pe}_CarryBug{carry_bug}_Compact{compact}"
+    params = {"N": n_pe, "CarryBug": carry_bug, "Compact": compact, "InReg": in_reg}
+    build_dir = TB_DIR / f"sim_build_N{n_pe}_CarryBug{carry_bug}_Compact{compact}_InReg{in_reg}"
     runner.build(
         sources=_sources(),
         hdl_toplevel="de_pe_chain",
@@ -423,7 +446,7 @@ def _run(carry_bug: int, n_pe: int = 9, compact: int = 0) -> None:
         build_args=["-Wno-fatal", "-O3"],
         waves=bool(int(os.environ.get("WAVES", "0"))),
     )
-    env = {"DE_CARRY_BUG": str(carry_bug), "DE_N_PE": str(n_pe),
+    env = {"DE_CARRY_BUG": str(carry_bug), "DE_N_PE": str(n_pe), "DE_IN_REG": str(in_reg),
            "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT / "sw"),
                                                        os.environ.get("PYTHONPATH")]))}
     # Under pytest the runner itself fails the test if a cocotb test failed.
@@ -446,5 +469,11 @@ try:
     @pytest.mark.parametrize("carry_bug", [0, 1])
     def test_de_pe(carry_bug, compact):
         _run(carry_bug, compact=compact)
+
+    # InReg: the PE with its input registered (de_chip InReg, the chip of the FPGA flow):
+    # the same states, each PE one clock later per position.
+    @pytest.mark.parametrize("carry_bug", [0, 1])
+    def test_de_pe_in_reg(carry_bug):
+        _run(carry_bug, in_reg=1)
 except ImportError:  # pragma: no cover
     pass

@@ -63,7 +63,11 @@ def geom(dut):
     g.update(isa.video_mode_fields(int(dut.TestMode.value)))
     g["n_pe"] = 9 * g["NumChips"]
     g["SpanArray"] = int(dut.SpanArray.value)
-    g["ArrayLatency"] = int(dut.SpanLatency.value) if g["SpanArray"] else g["NumChips"] + 3
+    g["InReg"] = int(dut.InReg.value)
+    # docs/array.md, "Pixel timing": NumChips + 3; with InReg (each PE's input
+    # registered) 10 NumChips + 4.
+    g["ArrayLatency"] = (int(dut.SpanLatency.value) if g["SpanArray"]
+                         else 10 * g["NumChips"] + 4 if g["InReg"] else g["NumChips"] + 3)
     return g
 
 
@@ -540,6 +544,10 @@ RUNS = {
     "busy800": dict(NumChips=1, CarryBug=0, NumBuf=4, BufDepth=16, NumBins=16,
                     BinShift=7, MaxLines=16,
                     TestMode=isa.video_mode_param((9, 16, 96, 679), (16, 1, 2, 2))),
+    # The arrays of the FPGA flow's chip (de_array InReg = 1: each PE's input registered):
+    # the same frames, ArrayLatency 24 clocks instead of 5.
+    "chips2_bug0_inreg": dict(NumChips=2, CarryBug=0, NumBuf=2, BufDepth=32, NumBins=4,
+                              BinShift=3, MaxLines=8, InReg=1),
     # The span-serial array (docs/fpga.md 3) in place of each de_array: 18 columns in
     # block RAM on its own clock, pixels 30 pixel clocks after the Refresh.
     "span_chips2": dict(NumChips=2, CarryBug=0, NumBuf=2, BufDepth=32, NumBins=4,
