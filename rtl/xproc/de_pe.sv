@@ -35,7 +35,7 @@ module de_pe
   parameter int unsigned PixCopy = 0,
   // 1 = the PE registers its own input (id_i, data_i) before stage 0 and computes beside
   // that register, a cycle early, what stage 0 would otherwise compute behind it: block
-  // 1's zero test, X - 1 and stage 0's SRC and DST operands (docs/xproc.md section 9).
+  // 1's zero test, X - 1 and stage 0's SRC and DST operands (docs/xproc.md section 11).
   // The PE then costs two clocks on the bus instead of one; its registers hold the same
   // values for the same slots, one clock later. blk1z_i and idsel_i are not read and
   // blk1z_o is constant (the next PE tests its own input). 0 when Compact.
