@@ -38,6 +38,7 @@ for f in rtl/board/*.sv; do
   esac
 done
 lint_top de_async_fifo $(files prim lint)
+lint_top de_delay $(files prim lint)
 lint_top de_span_array $(files span_array lint)
 lint_top de_span_video $(files span_video lint)
 # sim/fast: the fast array's pieces and its DPI shell (simulation wiring around the same

@@ -13,27 +13,16 @@ module de_deskew
   output logic [IdW-1:0]               id_o,
   output logic [DataW-1:0]             data_o
 );
-  logic [IdW-1:0]  ident_q, ident_q2;
-  logic [BlkW-1:0] blk0_q, blk0_q2, blk1_q;
+  // The identifier travels with block 0: both wait for the last block.
+  de_delay #(.Width(IdW), .Depth(NumBlk - 1)) u_id (.clk_i, .rst_i, .d_i(id_i), .q_o(id_o));
 
-  always_ff @(posedge clk_i) begin
-    if (rst_i) begin
-      ident_q  <= '0;
-      ident_q2 <= '0;
-      blk0_q   <= '0;
-      blk0_q2  <= '0;
-      blk1_q   <= '0;
-    end else begin
-      ident_q  <= id_i;
-      ident_q2 <= ident_q;
-      blk0_q   <= blk_i[0];
-      blk0_q2  <= blk0_q;
-      blk1_q   <= blk_i[1];
-    end
+  for (genvar j = 0; j < NumBlk; j++) begin : g_blk
+    de_delay #(.Width(BlkW), .Depth(NumBlk - 1 - j)) u_delay (
+      .clk_i, .rst_i,
+      .d_i(blk_i[j]),
+      .q_o(data_o[j*BlkW +: BlkW])
+    );
   end
-
-  assign id_o    = ident_q2;
-  assign data_o  = {blk_i[2], blk1_q, blk0_q2};
 endmodule
 
 `default_nettype wire

@@ -14,24 +14,16 @@ module de_skew
   output logic [IdW-1:0]               id_o,
   output logic [NumBlk-1:0][BlkW-1:0]  blk_o    // block j delayed by j clocks
 );
-  // Block j of data_i is data_i[j*BlkW +: BlkW], as de_pkg::word_blk selects it; written
-  // as slices, since calling word_blk mapped de_array to a different (equivalent) netlist.
-  logic [BlkW-1:0] blk1_q, blk2_q, blk2_q2;
+  assign id_o = id_i;
 
-  always_ff @(posedge clk_i) begin
-    if (rst_i) begin
-      blk1_q  <= '0;
-      blk2_q  <= '0;
-      blk2_q2 <= '0;
-    end else begin
-      blk1_q  <= data_i[1*BlkW +: BlkW];
-      blk2_q  <= data_i[2*BlkW +: BlkW];
-      blk2_q2 <= blk2_q;
-    end
+  // Block j of data_i is data_i[j*BlkW +: BlkW], as de_pkg::word_blk selects it.
+  for (genvar j = 0; j < NumBlk; j++) begin : g_blk
+    de_delay #(.Width(BlkW), .Depth(j)) u_delay (
+      .clk_i, .rst_i,
+      .d_i(data_i[j*BlkW +: BlkW]),
+      .q_o(blk_o[j])
+    );
   end
-
-  assign id_o  = id_i;
-  assign blk_o = {blk2_q2, blk1_q, data_i[0 +: BlkW]};
 endmodule
 
 `default_nettype wire

@@ -283,7 +283,7 @@ struct PeProbe {
   int pe;
   Sig reg[kNumRegs];
   Sig in_id, in_data;  // upstream registers (PE p-1 or the chip boundary); PE 0: none
-  Sig skew1, skew2;    // PE 0 only: de_skew's block-1 and block-2 registers
+  Sig skew1, skew2;    // PE 0 only: de_skew's block-1 and block-2 delay lines
 };
 
 bool make_probe(int p, PeProbe& pr, std::string& err) {
@@ -296,8 +296,9 @@ bool make_probe(int p, PeProbe& pr, std::string& err) {
   for (int i = 0; i < kNumRegs; ++i)
     if (!bind(s, kRegNames[i], pr.reg[i], err)) return false;
   if (p == 0) {
-    const VerilatedScope* sk = find_scope("de_array.u_skew");
-    return bind(sk, "blk1_q", pr.skew1, err) && bind(sk, "blk2_q2", pr.skew2, err);
+    // de_skew's delay lines (rtl/prim/de_delay.sv): block j's registers, newest first.
+    return bind(find_scope("de_array.u_skew.g_blk[1].u_delay.g_regs"), "stage_q", pr.skew1, err) &&
+           bind(find_scope("de_array.u_skew.g_blk[2].u_delay.g_regs"), "stage_q", pr.skew2, err);
   }
   if (p % kPePerChip) {
     const VerilatedScope* up = find_scope(pe_scope(p - 1));
@@ -317,7 +318,7 @@ std::string state_row(uint64_t cycle, const PeProbe& pr, const Instr& in0, long 
   if (pr.pe == 0) {
     id = in0.ident;
     data = (in0.data & DE_BLOCK_MASK) | (pr.skew1.get() << DE_BLOCK_BITS) |
-           (pr.skew2.get() << (2 * DE_BLOCK_BITS));
+           (((pr.skew2.get() >> DE_BLOCK_BITS) & DE_BLOCK_MASK) << (2 * DE_BLOCK_BITS));
   } else {
     id = pr.in_id.get();
     data = pr.in_data.get();
