@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Load a scene and its animation into the board over the UART loader (docs/board.md §3).
 
-    de32_load.py PORT SCENE [--anim DIR] [--window W --round] [--hold N] [--resume]
+    de32_load.py PORT SCENE [--anim DIR] [--window W --round] [--gain G] [--shift S]
+                 [--hold N] [--resume]
     de32_load.py PORT r.de32 g.de32 b.de32 [--shift 0] [--nosat]
     de32_load.py PORT --status | --reg 0x3000
 
@@ -16,7 +17,10 @@ order, --hold display frames each, in a loop (--no-loop: stop on the last); --sh
 plays frame F alone. The output window ('O') is set last. .de48 streams are turned
 into frame-store words at DAC window --window; with --round, operands are rounded to
 that window's grid (otherwise a value the frame store cannot hold is an error naming
-the file and slot).
+the file and slot). The 27-bit operand holds intensities below 2^(w+6) pixel units:
+`make demo`'s 12-bit scenes need --window 4 --round --gain 1 (intensities halved) and
+the output window --shift 3 to show the 8 bits `make demo` shows; an operand clamped
+to the range is reported (the frame would not look like the stream).
 
 Link: 3,000,000 baud 8N1 (--baud), the FT231X's maximum, as the bitstream is built.
 Every packet is answered: 'K' next packet; 'E' (checksum or field error) or 'T' (the
@@ -101,25 +105,34 @@ def read_de32(path: str) -> Image:
     return list(struct.unpack(f">{n}I", data[8:])), data[6], bool(data[7] & 1)
 
 
-def round_slot(ident: int, data: int, window: int) -> int:
-    """The 36-bit data of a slot rounded to the nearest value the frame store holds."""
+def round_slot(ident: int, data: int, window: int, gain: int = 0) -> tuple[int, bool]:
+    """The 36-bit data of a slot, its intensity divided by 2^gain, rounded to the nearest
+    value the frame store holds at `window`; and whether it had to be clamped to the
+    store's range (Eval0 fields: 7 bits at pixel bits [w+6:w]; intensity operands:
+    |v| < 2^(w+6) pixel units, docs/formats.md §3)."""
     from diffengine import isa
     typ = isa.ID_TYPE[ident]
     if typ == isa.TYPE_ADDR:
         b2 = data >> 24
         v = b2 - (1 << 12) if b2 & 0x800 else b2
-        q = max(-64, min(63, (v + (1 << window >> 1)) >> window))
-        return (data & 0xFFFFFF) | ((q << window) & 0xFFF) << 24
+        sh = window + gain
+        q = (v + (1 << sh >> 1)) >> sh
+        c = max(-64, min(63, q))
+        return (data & 0xFFFFFF) | ((c << window) & 0xFFF) << 24, c != q
     if typ != isa.TYPE_NONE:
         low = 4 + window
-        q = (isa.to_signed(data) + (1 << (low - 1))) >> low
-        q = max(-(1 << 26), min((1 << 26) - 1, q))
-        return isa.to_word(q << low)
-    return data
+        q = (isa.to_signed(data) + (1 << (low + gain - 1))) >> (low + gain)
+        c = max(-(1 << 26), min((1 << 26) - 1, q))
+        return isa.to_word(c << low), c != q
+    return data, False
 
 
-def de48_image(data: bytes, name: str, window: int, rnd: bool) -> Image:
-    """A .de48 stream -> frame-store words at `window` (docs/formats.md §3)."""
+def de48_image(data: bytes, name: str, window: int, rnd: bool, gain: int = 0) -> Image:
+    """A .de48 stream -> frame-store words at `window` (docs/formats.md §3). With `gain`
+    G > 0 every intensity is divided by 2^G first (and rounded, as with `rnd`): the
+    scenes' 12-bit intensities need G = 1 at window 4, shown with output shift 4 - G.
+    Operands clamped to the store's range are counted and reported on stderr: such a
+    frame does not look like its stream."""
     from diffengine import isa
     from diffengine.formats import binfmt
     from diffengine.formats.asm import AsmError
@@ -127,27 +140,35 @@ def de48_image(data: bytes, name: str, window: int, rnd: bool) -> Image:
         slots = binfmt.decode_de48(data, name)
     except AsmError as e:
         raise LoadError(str(e)) from None
-    words = []
+    if not 0 <= gain <= 3:
+        raise LoadError(f"{name}: --gain {gain} outside 0..3")
+    words, clamped = [], 0
     for k, (ident, d) in enumerate(slots):
-        if rnd:
-            d = round_slot(ident, d, window)
+        if rnd or gain:
+            d, cl = round_slot(ident, d, window, gain)
+            clamped += cl
         try:
             words.append(isa.LUT_INDEX[ident] << binfmt.OPERAND_BITS
                          | binfmt._fs_operand(ident, d, window))
         except (ValueError, KeyError) as e:
             raise LoadError(f"{name}:slot {k}: {e} (give --round, or another --window)") \
                 from None
+    if clamped:
+        print(f"de32_load: {name}: {clamped:,} of {len(slots):,} operands clamped to the "
+              f"frame store's range at window {window}, gain {gain}: the frame will not look "
+              f"like the stream (give --gain {gain + 1}, shown with --shift "
+              f"{max(0, 3 - gain)})", file=sys.stderr)
     return words, window, False
 
 
-def read_image(path: str, window: int | None, rnd: bool) -> Image:
+def read_image(path: str, window: int | None, rnd: bool, gain: int = 0) -> Image:
     head = Path(path).read_bytes()[:4]
     if head == b"DE32":
         return read_de32(path)
     if head == b"DE48":
         if window is None:
             raise LoadError(f"{path}:byte 0: a .de48 stream needs --window (0..4)")
-        return de48_image(Path(path).read_bytes(), path, window, rnd)
+        return de48_image(Path(path).read_bytes(), path, window, rnd, gain)
     raise LoadError(f"{path}:byte 0: neither .de32 nor .de48 (docs/formats.md)")
 
 
@@ -171,8 +192,8 @@ def scene_files(paths: list[str]) -> list[str]:
     return list(paths)
 
 
-def read_scene(paths: list[str], window, rnd) -> list[Image]:
-    return [read_image(p, window, rnd) for p in scene_files(paths)]
+def read_scene(paths: list[str], window, rnd, gain: int = 0) -> list[Image]:
+    return [read_image(p, window, rnd, gain) for p in scene_files(paths)]
 
 
 def anim_dir(d: str) -> Path:
@@ -194,7 +215,7 @@ def anim_files(d: str, n: int) -> list[list[str]]:
              for c in "rgb"] for f in range(n)]
 
 
-def read_anim(d: str, window, rnd) -> list[list[Image]]:
+def read_anim(d: str, window, rnd, gain: int = 0) -> list[list[Image]]:
     from diffengine.pipeline import anim
     if window is None:
         raise LoadError(f"{d}: an animation's .de48 streams need --window (0..4)")
@@ -203,7 +224,7 @@ def read_anim(d: str, window, rnd) -> list[list[Image]]:
         seq = anim.frames(p)
     except ValueError as e:
         raise LoadError(f"{p}: {e}") from None
-    return [[de48_image(anim.to_de48(ch), f"{p}/frame{f:03d} {'rgb'[c]}", window, rnd)
+    return [[de48_image(anim.to_de48(ch), f"{p}/frame{f:03d} {'rgb'[c]}", window, rnd, gain)
              for c, ch in enumerate(fr)] for f, fr in enumerate(seq)]
 
 
@@ -421,6 +442,9 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--anim", help="make anim output directory: load all its frames too")
     ap.add_argument("--window", type=int, choices=range(5), help="DAC window for .de48")
     ap.add_argument("--round", action="store_true", help="round .de48 operands to the window")
+    ap.add_argument("--gain", type=int, default=0, choices=range(4),
+                    help="divide .de48 intensities by 2^GAIN first, rounded: make demo's "
+                         "12-bit scenes need 1 at window 4, shown with --shift 3 (0)")
     ap.add_argument("--show", type=int, help="play this frame alone (default: all, in order)")
     ap.add_argument("--hold", type=int, default=1,
                     help="display frames per animation frame, 1..255 (1)")
@@ -454,10 +478,10 @@ def main(argv=None, port_fd: int | None = None) -> int:
     try:
         frames, names = [], []
         if a.scene:
-            frames.append(read_scene(a.scene, a.window, a.round))
+            frames.append(read_scene(a.scene, a.window, a.round, a.gain))
             names.append(scene_files(a.scene))
         if a.anim:
-            seq = read_anim(a.anim, a.window, a.round)
+            seq = read_anim(a.anim, a.window, a.round, a.gain)
             frames += seq
             names += anim_files(a.anim, len(seq))
         port = Port(port_fd if port_fd is not None else a.port, a.baud)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Pack frames into the SDRAM frame store as tables of lines (docs/sdram-frames-spec.md §1-2, §6).
 
-    frame_pack.py SCENE_OR_ANIM [...] [--vactive 480] [--window 2] [--no-round]
+    frame_pack.py SCENE_OR_ANIM [...] [--vactive 480] [--window 2] [--no-round] [--gain G]
                   [--stats] [--json FILE] [--image FILE]
 
 Each colour's word stream is cut into line blocks at the end-of-line markers (the
@@ -294,7 +294,7 @@ def read_image_file(path) -> dict[int, int]:
 
 
 # ---------------------------------------------------------------------------- CLI
-def load_inputs(paths: list[str], window: int, rnd: bool) -> list:
+def load_inputs(paths: list[str], window: int, rnd: bool, gain: int = 0) -> list:
     """Frames from scene directories and `make anim` directories, in order."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     import de32_load                                  # its readers; lazy: it imports us
@@ -302,9 +302,9 @@ def load_inputs(paths: list[str], window: int, rnd: bool) -> list:
     for p in paths:
         d = Path(p)
         if (d / "frame000").is_dir() or (d / "streams" / "frame000").is_dir():
-            frames += de32_load.read_anim(str(d), window, rnd)   # finds streams/ itself
+            frames += de32_load.read_anim(str(d), window, rnd, gain)   # finds streams/ itself
         else:
-            frames.append(de32_load.read_scene([str(d)], window, rnd))
+            frames.append(de32_load.read_scene([str(d)], window, rnd, gain))
     return frames
 
 
@@ -334,6 +334,8 @@ def main(argv=None) -> int:
                     help="DAC window for .de48 streams (2)")
     ap.add_argument("--no-round", action="store_true",
                     help="do not round .de48 operands to the window (an unfit one is an error)")
+    ap.add_argument("--gain", type=int, default=0, choices=range(4),
+                    help="divide .de48 intensities by 2^GAIN first (de32_load.py --gain) (0)")
     ap.add_argument("--first-slot", type=int, default=0, help="slot of frame 0 (0)")
     ap.add_argument("--hold", type=int, default=1, help="display frames per slot (1)")
     ap.add_argument("--no-loop", action="store_true", help="stop at the last frame")
@@ -342,7 +344,7 @@ def main(argv=None) -> int:
     ap.add_argument("--image", help="write the SDRAM model preload file (spec §5)")
     a = ap.parse_args(argv)
     try:
-        frames = load_inputs(a.inputs, a.window, not a.no_round)
+        frames = load_inputs(a.inputs, a.window, not a.no_round, a.gain)
         # Pack past the region (up to what a table entry can address) so that --stats can
         # say by how much it does not fit; the API's default is an error at the overflow.
         plan = pack(frames, a.vactive, first_slot=a.first_slot, hold=a.hold,

@@ -2,16 +2,20 @@
 """Whole-board full-frame simulations (issue 18 item 4, docs/board-frames.md).
 
     board_sim.py [--cases teapot,cad,anim] [--out out/board_sim] [--anim-frames 0,1,2]
-                 [--loops 1] [--window 4] [--threads 1] [--no-build]
+                 [--loops 1] [--window 4] [--gain 1] [--threads 1] [--no-build]
 
 Each case: `yproc scan` (the teapot and the CAD scene, at the board's line capacity,
 as `make demo` runs it) or `yproc anim` (the shipped animation, as `make anim`) writes
-the colour streams; they become frame-store words at window --window (4; rounded, as
-`de32_load.py --window 4 --round` does), `fpga/ulx3s/frame_pack.py` packs them into
+the colour streams; they become frame-store words at window --window (4) with the
+intensities halved --gain times (1) and rounded, as `de32_load.py --window 4 --round
+--gain 1` does (the 27-bit operand holds intensities below 1,024 pixel units at window
+4; the scenes' reach 4,095); `fpga/ulx3s/frame_pack.py` packs them into
 tables of lines and writes the SDRAM model's preload image; the golden frames are the C
 functional model (`diffengine.model.fast`) of the mapped words, through the 8-bit
-output window set to the same window (`O` shift 4, no saturation: pixel[11:4], `make
-demo`'s 8-bit view).
+output window (`O` shift 4 - gain, no saturation: with gain 1 pixel[10:3] of the halved
+intensities, which is `make demo`'s 8-bit view, pixel[11:4]). Each case also renders
+its .de48 streams themselves and reports how many pixels of the golden frame differ
+from that 8-bit view (the frame store's loss; summary "store loss").
 The Verilated board (sim/board: de_board_core, 72 chips per colour as span-serial
 arrays, mode 0 = 640x480, SDRAM model at 125 MHz CL 3) starts from the preload; the
 harness sends the `O`, `F` and `Q` packets over the UART at 3 Mbaud, decodes the three
@@ -21,9 +25,10 @@ late-line and dropped-word totals and the SDRAM model's violation count.
 Checks per case: every frame after the sequence starts equals its golden frame exactly,
 in the sequence's order (an animation: frames 0, 1, 2, switching at frame boundaries;
 --loops > 0 also shows the wrap back to frame 0), 0 late lines, 0 dropped words,
-0 SDRAM violations, sync and loader replies right; the span arrays' FIFO overflow and
+0 SDRAM violations, sync and loader replies right, and each golden frame at most 1 % of
+its pixels more than 8 levels off the streams' own view; the span arrays' FIFO overflow and
 late flags are reported as warnings. Writes per case OUT/CASE/: the decoded frames as
-PNG (frame_NN.png), golden_NN.png, diff_NN.png (differing pixels red, each in a red
+PNG (frame_NN.png), golden_NN.png, streams_NN.png (the streams' own view), diff_NN.png (differing pixels red, each in a red
 9x9 box, on the dimmed golden), strip.png (an animation's frames side by side),
 stats.json (the harness's); OUT/summary.json and OUT/summary.md. Exit status 0 only if
 every case passed.
@@ -52,7 +57,11 @@ from diffengine.model import fast  # noqa: E402
 WIDTH, HEIGHT, MODE = 640, 480, 0
 CAPACITY = 798                    # mode 0's usable slots per line (make demo's --capacity)
 WINDOW = 4                        # frame-store window (--window)
-SHIFT, SAT = 4, False             # the 8-bit output window (shift = window), wrapping
+GAIN = 1                          # intensities halved this often (--gain)
+SHIFT, SAT = 3, False             # the 8-bit output window (shift = window - gain), wrapping
+# The frame store's loss against the streams: at most this share of a frame's pixels may
+# differ from the streams' own 8-bit view by more than LOSS_LEVELS (any colour).
+LOSS_LEVELS, LOSS_MAX = 8, 0.01
 SCENES = {"teapot": ROOT / "sw/scenes/teapot/teapot.scene",
           "cad": ROOT / "sw/scenes/cad/cad.scene"}
 ANIM = ROOT / "sw/scenes/anim/cad_drag.anim"
@@ -88,7 +97,7 @@ def streams(case: str, out: Path) -> Path:
 def case_frames(case: str, d: Path, anim_frames: list[int]) -> list:
     """Frames [f][c] = (words, window, comp) as the host tool reads them."""
     if case in SCENES:
-        return [de32_load.read_scene([str(d)], WINDOW, True)]
+        return [de32_load.read_scene([str(d)], WINDOW, True, GAIN)]
     from diffengine.pipeline import anim
     every = anim.frames(d)                    # the lines of every frame (deltas applied)
     bad = [f for f in anim_frames if not 0 <= f < len(every)]
@@ -96,7 +105,41 @@ def case_frames(case: str, d: Path, anim_frames: list[int]) -> list:
         raise SystemExit(f"board_sim: --anim-frames {bad}: the animation has {len(every)} frames")
     # Only the frames played become frame-store words (de32_load.read_anim's conversion).
     return [[de32_load.de48_image(anim.to_de48(every[f][c]), f"{d} frame {f} {'rgb'[c]}",
-                                  WINDOW, True) for c in range(3)] for f in anim_frames]
+                                  WINDOW, True, GAIN) for c in range(3)] for f in anim_frames]
+
+
+def stream_views(case: str, d: Path, anim_frames: list[int]) -> np.ndarray:
+    """(frames, H, W, 3): the .de48 streams themselves through the C functional model,
+    at `make demo`'s 8-bit view of the window (pixel[WINDOW+7:WINDOW]), no frame store."""
+    if case in SCENES:
+        per_frame = [[(d / f"{c}.de48").read_bytes() for c in "rgb"]]
+    else:
+        from diffengine.pipeline import anim
+        every = anim.frames(d)
+        per_frame = [[anim.to_de48(every[f][c]) for c in range(3)] for f in anim_frames]
+    views = []
+    for streams3 in per_frame:
+        img = np.zeros((HEIGHT, WIDTH, 3), dtype=np.uint16)
+        for c, de48 in enumerate(streams3):
+            slots = binfmt.decode_de48(de48, f"{d} {'rgb'[c]}")
+            data = b"".join(((i << isa.WORD_BITS) | x).to_bytes(6, "big") for i, x in slots)
+            fast.render_words(data, WIDTH, img[..., c], name=f"colour {'rgb'[c]}")
+        views.append(((img.astype(np.int32) >> WINDOW) & 0xFF).astype(np.uint8))
+    return np.stack(views)
+
+
+def store_loss(gold: np.ndarray, views: np.ndarray) -> list[dict]:
+    """Per frame: how far the golden frame (the frame-store words) is from the streams'
+    own view; levels wrap at 256 as the output window does."""
+    out = []
+    for g, v in zip(gold, views):
+        d = np.abs(g.astype(np.int32) - v.astype(np.int32))
+        d = np.minimum(d, 256 - d).max(axis=-1)
+        out.append({"pixels_differing": int((d > 0).sum()),
+                    f"over_{LOSS_LEVELS}_levels": round(float((d > LOSS_LEVELS).mean()), 6),
+                    "over_32_levels": round(float((d > 32).mean()), 6),
+                    "max_levels": int(d.max())})
+    return out
 
 
 def out8(p: np.ndarray) -> np.ndarray:
@@ -159,6 +202,14 @@ def run_case(case: str, a, exe: Path) -> dict:
     gold.tofile(out / "golden.rgb")
     for k, g in enumerate(gold):
         frame.write_rgb8(out / f"golden_{k:02d}.png", g)
+    views = stream_views(case, d, a.anim_frames)
+    loss = store_loss(gold, views)
+    for k, v in enumerate(views):
+        frame.write_rgb8(out / f"streams_{k:02d}.png", v)
+    log(f"{case}: store loss (golden vs the streams' own 8-bit view): " + "; ".join(
+        f"frame {k}: {x['pixels_differing']:,} pixels differ, "
+        f"{x[f'over_{LOSS_LEVELS}_levels']:.2%} by more than {LOSS_LEVELS} levels"
+        for k, x in enumerate(loss)))
     st = plan.stats()
     used = ", ".join(f"{s['words_used']:,}" for s in st)
     ref = ", ".join(f"{s['words_referenced']:,}" for s in st)
@@ -177,6 +228,12 @@ def run_case(case: str, a, exe: Path) -> dict:
         return {"case": case, "ok": False, "errors": [f"harness exit status {r.returncode}"]}
     res = json.loads((out / "stats.json").read_text())
     live, order, expect, errors = sequence_check(res, len(frames), plan.sequence[2], want)
+    for k, x in enumerate(loss):
+        if x[f"over_{LOSS_LEVELS}_levels"] > LOSS_MAX:
+            errors.append(f"frame {k}: the frame store loses the picture: "
+                          f"{x[f'over_{LOSS_LEVELS}_levels']:.2%} of the pixels differ from the "
+                          f"streams by more than {LOSS_LEVELS} levels (over {LOSS_MAX:.0%}; "
+                          f"streams_{k:02d}.png against golden_{k:02d}.png; --gain)")
     dec = np.fromfile(out / "frames.rgb", dtype=np.uint8)
     dec = dec.reshape(-1, HEIGHT, WIDTH, 3) if dec.size else dec.reshape(0, HEIGHT, WIDTH, 3)
     for k, (f, img) in enumerate(zip(live, dec)):
@@ -207,6 +264,7 @@ def run_case(case: str, a, exe: Path) -> dict:
         "black_frames_before": res["first_live_frame"], "status": res["status"],
         "warnings": res["warnings"],
         "span_overflow_first": [sa["overflow_first"] for sa in res["span_arrays"]],
+        "window": WINDOW, "gain": GAIN, "shift": SHIFT, "store_loss": loss,
     }
     log(f"{case}: {'PASS' if summary['ok'] else 'FAIL'}: frames {order} (want {expect}), "
         f"pixels differing {summary['pixels_differing']}, late lines {res['late_lines']}, "
@@ -221,11 +279,11 @@ def write_summary(results: list[dict], out: Path, a) -> None:
     (out / "summary.json").write_text(json.dumps(results, indent=1) + "\n")
     rows = ["| case | frames (shown / want) | pixels differing | late lines | dropped words "
             "| SDRAM violations | span FIFO overflow (first: frame, line) | simulated "
-            "| wall (CPU) | result |",
-            "|---|---|---|---|---|---|---|---|---|---|"]
+            "| store loss (pixels > 8 levels off the streams) | wall (CPU) | result |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         if "frames_shown" not in r:
-            rows.append(f"| {r['case']} | - | - | - | - | - | - | - | - | FAIL: {r['errors']} |")
+            rows.append(f"| {r['case']} | - | - | - | - | - | - | - | - | - | FAIL: {r['errors']} |")
             continue
         ovf = sorted({(o[1] - r["black_frames_before"], o[2]) for o in r["span_overflow_first"]
                       if o[0] >= 0})
@@ -235,13 +293,17 @@ def write_summary(results: list[dict], out: Path, a) -> None:
         rows.append(f"| {r['case']} | {shown} / {want} | "
                     f"{r['pixels_differing']} | {r['late_lines']} | {r['dropped_words']} | "
                     f"{r['sdram_violations']} | {ovf_s} | {r['simulated_ms']:.1f} ms | "
+                    + ", ".join(f"{x[f'over_{LOSS_LEVELS}_levels']:.2%}" for x in r["store_loss"])
+                    + " | "
                     f"{r['seconds']:.0f} s ({r['cpu_seconds']:.0f} s) | "
                     f"{'PASS' if r['ok'] else 'FAIL'} |")
     (out / "summary.md").write_text(
         f"# Whole-board full-frame simulations\n\n`{' '.join(sys.argv)}`, "
         f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}\n\n" + "\n".join(rows)
         + "\n\nFrames shown: the golden frame each decoded frame equals exactly, from the first "
-        "that is not black (≠: none).\n")
+        "that is not black (≠: none). Store loss: the golden frame (the frame-store words, "
+        f"window {WINDOW}, gain {GAIN}, output shift {SHIFT}) against the .de48 streams' own "
+        "8-bit view, per frame.\n")
 
 
 def main(argv=None) -> int:
@@ -256,12 +318,18 @@ def main(argv=None) -> int:
     ap.add_argument("--loops", type=int, default=0,
                     help="extra passes through the sequence (1: see the wrap; 0)")
     ap.add_argument("--window", type=int, default=4, choices=range(5),
-                    help="frame-store window of the streams and output shift (4)")
+                    help="frame-store window of the streams (4)")
+    ap.add_argument("--gain", type=int, default=1, choices=range(4),
+                    help="halve the streams' intensities this often before they become "
+                         "frame-store words; the output shift is window - gain (1)")
     ap.add_argument("--threads", type=int, default=1, help="Verilator threads (1)")
     ap.add_argument("--no-build", action="store_true", help="use the built harness as is")
     a = ap.parse_args(argv)
-    global WINDOW, SHIFT
-    WINDOW = SHIFT = a.window
+    global WINDOW, GAIN, SHIFT
+    WINDOW, GAIN = a.window, a.gain
+    if GAIN > WINDOW:
+        ap.error(f"--gain {GAIN} over --window {WINDOW}: the output shift would be negative")
+    SHIFT = WINDOW - GAIN
     cases = a.cases.split(",")
     bad = [c for c in cases if c not in (*SCENES, "anim")]
     if bad:

@@ -54,3 +54,22 @@ def test_harness_errors_are_kept():
     res["errors"] = ["3 late line(s)"]
     _, _, _, errors = board_sim.sequence_check(res, 1, 1, 2)
     assert errors == ["3 late line(s)"]
+
+
+def test_store_loss_counts_what_the_store_lost():
+    """The golden frame (the frame-store words) against the streams' own 8-bit view: a
+    frame with 2 % of its pixels 40 levels off is over the 1 % limit; 250 levels off is 6
+    levels the other way round (the output window wraps), within the limit."""
+    import numpy as np
+    views = np.full((2, 10, 100, 3), 100, dtype=np.uint8)
+    gold = views.copy()
+    gold[0, 0, :20, 1] += 40                 # 20 of 1,000 pixels, one colour each
+    gold[1, :, :, 2] = (gold[1, :, :, 2].astype(int) + 250) % 256
+    loss = board_sim.store_loss(gold, views)
+    key = f"over_{board_sim.LOSS_LEVELS}_levels"
+    assert loss[0]["pixels_differing"] == 20 and loss[0][key] == 0.02 > board_sim.LOSS_MAX
+    assert loss[0]["over_32_levels"] == 0.02 and loss[0]["max_levels"] == 40
+    assert loss[1]["pixels_differing"] == 1000 and loss[1][key] == 0.0
+    assert loss[1]["max_levels"] == 6
+    assert board_sim.store_loss(views, views)[0] == {
+        "pixels_differing": 0, key: 0.0, "over_32_levels": 0.0, "max_levels": 0}

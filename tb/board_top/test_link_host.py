@@ -331,3 +331,45 @@ def test_help_and_progress(capsys):
     line = p.line()
     assert "150.0/300.0 kB" in line and "kB/s" in line and "ETA" in line, line
     assert line.startswith("[" + "#" * 15 + " " * 15 + "]"), line
+
+
+def _line_pixels(slots) -> "np.ndarray":
+    """One line of 12-bit pixels: the C functional model of (ident, data) slots."""
+    import numpy as np
+    from diffengine import isa
+    from diffengine.model import fast
+    row = np.zeros((1, 640), dtype=np.uint16)
+    fast.render_words(b"".join(((i << isa.WORD_BITS) | d).to_bytes(6, "big") for i, d in slots),
+                      640, row)
+    return row[0].astype(int)
+
+
+def test_de48_bright_intensities_need_gain(tmp_path, capsys):
+    """make demo's scenes reach 4,095 pixel units; the 27-bit operand holds |v| < 1,024 at
+    window 4 (docs/formats.md §3). Gain 0 clamps them (reported on stderr, naming the
+    stream) and the line no longer looks like the stream; gain 1 halves every intensity
+    and the output window one bit lower (pixel[10:3]) shows make demo's 8 bits
+    (pixel[11:4]) exactly."""
+    from diffengine import isa
+    from diffengine.formats import asm, binfmt
+    # Intensities are 12-bit two's complement: -1800 shows as pixel 2,296.
+    text = ("Eval1 (0, 200, 1800)\nEval2 (200, 240, 1500, 2.25)\n"
+            "Eval3 (440, 200, -1800, -3.5, 0.0078125)\nRefresh\n")
+    slots = isa.serialise(asm.parse_text(text, "bright.txt"))
+    de48 = binfmt.encode_de48(slots)
+    want = (_line_pixels(slots) >> 4) & 0xFF
+    assert want.max() > 1024 >> 4                      # the line is bright
+
+    words, window, _ = dl.de48_image(de48, "bright.de48", 4, True, 0)
+    err = capsys.readouterr().err
+    assert "bright.de48" in err and "clamped" in err and "--gain 1" in err
+    got0 = (_line_pixels(binfmt.framestore_slots(words, window)) >> 4) & 0xFF
+    assert (got0 != want).sum() > 100                  # clamped: a different line
+
+    words, window, _ = dl.de48_image(de48, "bright.de48", 4, True, 1)
+    assert "clamped" not in capsys.readouterr().err
+    got1 = (_line_pixels(binfmt.framestore_slots(words, window)) >> 3) & 0xFF
+    assert (got1 == want).all()
+
+    with pytest.raises(dl.LoadError, match="--gain 4 outside 0..3"):
+        dl.de48_image(de48, "bright.de48", 4, True, 4)
