@@ -154,10 +154,11 @@ def de48_image(data: bytes, name: str, window: int, rnd: bool, gain: int = 0) ->
             raise LoadError(f"{name}:slot {k}: {e} (give --round, or another --window)") \
                 from None
     if clamped:
+        hint = (f"give --gain {gain + 1}, shown with --shift {max(0, 3 - gain)}" if gain < 3
+                else "no gain avoids it at this window: give a higher --window")
         print(f"de32_load: {name}: {clamped:,} of {len(slots):,} operands clamped to the "
               f"frame store's range at window {window}, gain {gain}: the frame will not look "
-              f"like the stream (give --gain {gain + 1}, shown with --shift "
-              f"{max(0, 3 - gain)})", file=sys.stderr)
+              f"like the stream ({hint})", file=sys.stderr)
     return words, window, False
 
 

@@ -371,5 +371,9 @@ def test_de48_bright_intensities_need_gain(tmp_path, capsys):
     got1 = (_line_pixels(binfmt.framestore_slots(words, window)) >> 3) & 0xFF
     assert (got1 == want).all()
 
+    # At window 0 the range is +-64 pixel units: even gain 3 clamps, and says what to do.
+    dl.de48_image(de48, "bright.de48", 0, True, 3)
+    assert "higher --window" in capsys.readouterr().err
+
     with pytest.raises(dl.LoadError, match="--gain 4 outside 0..3"):
         dl.de48_image(de48, "bright.de48", 4, True, 4)
